@@ -1,0 +1,72 @@
+// Direct light from the scene's lights, in the units of the references:
+// point/spot intensity I [W/sr] gives irradiance E = I cos(theta) / d^2, a directional
+// light gives E = irradiance cos(theta), and a Lambertian surface returns rho/pi * E.
+#ifndef DIRECT_LIGHT_GLSL
+#define DIRECT_LIGHT_GLSL
+#include "common/frame.glsl"
+
+// Which shadow view of a light covers p: point lights have six cube faces, chosen by the
+// major axis of the light-to-point vector in the order +X -X +Y -Y +Z -Z.
+uint shadow_view_for(GpuLight light, vec3 p) {
+    if (light.shadow_view_count < 6u) {
+        return light.first_shadow_view;
+    }
+    vec3 d = p - light.position.xyz;
+    vec3 a = abs(d);
+    uint face;
+    if (a.x >= a.y && a.x >= a.z) {
+        face = d.x >= 0.0 ? 0u : 1u;
+    } else if (a.y >= a.z) {
+        face = d.y >= 0.0 ? 2u : 3u;
+    } else {
+        face = d.z >= 0.0 ? 4u : 5u;
+    }
+    return light.first_shadow_view + face;
+}
+
+// Fraction of the light reaching p (normal n), 5x5 PCF over bilinear depth compares.
+float shadow_visibility(GpuLight light, vec3 p, vec3 n) {
+    if (light.shadow_view_count == 0u) {
+        return 1.0;
+    }
+    ShadowView view = shadow_views[shadow_view_for(light, p)];
+    bool ortho = view.origin.w > 0.5;
+    // Normal offset of about two texels at p's distance keeps a surface from shadowing
+    // itself without the light leaking through thin walls.
+    float texel_world = ortho ? view.texel_size : view.texel_size * distance(p, view.origin.xyz);
+    vec4 clip = view.view_proj * vec4(p + n * (2.0 * texel_world), 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    vec2 uv = ndc.xy * 0.5 + 0.5;
+    vec2 texel_uv = 1.0 / vec2(textureSize(shadow_map, 0).xy);
+    float sum = 0.0;
+    for (int y = -2; y <= 2; y++) {
+        for (int x = -2; x <= 2; x++) {
+            sum += texture(shadow_map, vec4(uv + vec2(x, y) * texel_uv, float(view.layer), ndc.z));
+        }
+    }
+    return sum / 25.0;
+}
+
+// Irradiance at p (normal n) from one light, shadowed, and the unit vector towards it.
+vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, out vec3 to_light) {
+    vec3 e;
+    if (light.kind == LIGHT_DIRECTIONAL) {
+        to_light = -light.direction.xyz;
+        e = light.intensity.rgb;
+    } else {
+        vec3 d = light.position.xyz - p;
+        float dist2 = max(dot(d, d), 1e-8);
+        to_light = d * inversesqrt(dist2);
+        e = light.intensity.rgb / dist2;
+        if (light.kind == LIGHT_SPOT) {
+            float cos_axis = dot(-to_light, light.direction.xyz);
+            e *= smoothstep(light.direction.w, light.cos_inner, cos_axis);
+        }
+    }
+    float cos_theta = dot(n, to_light);
+    if (cos_theta <= 0.0) {
+        return vec3(0.0);
+    }
+    return e * cos_theta * shadow_visibility(light, p, n);
+}
+#endif

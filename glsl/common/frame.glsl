@@ -1,0 +1,18 @@
+// Set 0: per-frame uniforms, lights and shadow maps.
+#ifndef FRAME_GLSL
+#define FRAME_GLSL
+#include "gpu_layout.glsl"
+
+layout(set = SET_FRAME, binding = BINDING_FRAME_UNIFORMS) uniform FrameBlock {
+    FrameUniforms frame;
+};
+layout(set = SET_FRAME, binding = BINDING_LIGHTS, std430) readonly buffer LightBlock {
+    GpuLight lights[];
+};
+layout(set = SET_FRAME, binding = BINDING_SHADOW_VIEWS, std430) readonly buffer ShadowViewBlock {
+    ShadowView shadow_views[];
+};
+layout(set = SET_FRAME, binding = BINDING_SHADOW_MAP) uniform sampler2DArrayShadow shadow_map;
+
+const float PI = 3.14159265358979;
+#endif

@@ -1,0 +1,57 @@
+#version 460
+// Writes the surface attributes the lighting pass needs; position comes from depth.
+#include "common/frame.glsl"
+#include "common/scene.glsl"
+#include "common/mesh_push.glsl"
+
+layout(location = 0) in vec3 in_world;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 0) out vec4 out_albedo;   // rgb albedo, a specular (mean Ks)
+layout(location = 1) out vec4 out_normal;   // xyz world normal facing the camera, w roughness
+layout(location = 2) out vec4 out_emission; // rgb emitted radiance
+
+// Perturbs n by a tangent-space normal map with a cotangent frame from screen-space
+// derivatives (Schüler, "Normal mapping without precomputed tangents"), so meshes need
+// no tangents.
+vec3 apply_normal_map(vec3 n, uint map) {
+    vec3 dp1 = dFdx(in_world);
+    vec3 dp2 = dFdy(in_world);
+    vec2 duv1 = dFdx(in_uv);
+    vec2 duv2 = dFdy(in_uv);
+    vec3 dp2perp = cross(dp2, n);
+    vec3 dp1perp = cross(n, dp1);
+    vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
+    vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
+    float len = max(dot(t, t), dot(b, b));
+    if (len < 1e-20) {
+        return n;
+    }
+    float scale = inversesqrt(len);
+    vec3 m = sample_texture(map, in_uv).xyz * 2.0 - 1.0;
+    // Our v runs down the image (Vertex.uv), the map's green axis runs up it.
+    m.y = -m.y;
+    vec3 mapped = normalize(mat3(t * scale, b * scale, n) * m);
+    return any(isnan(mapped)) ? n : mapped;
+}
+
+void main() {
+    GpuMaterial m = materials[draw.material];
+    if (material_coverage(m, in_uv) < CUTOUT_THRESHOLD) {
+        discard;
+    }
+    vec3 to_camera = frame.camera_position.xyz - in_world;
+    vec3 n = normalize(in_normal);
+    // Emitters are one-sided along the winding normal, surfaces are two-sided.
+    bool front = dot(n, to_camera) >= 0.0;
+    if (!front) {
+        n = -n;
+    }
+    if ((frame.flags & FLAG_NORMAL_MAPS) != 0u && m.normal_texture != NO_TEXTURE) {
+        n = apply_normal_map(n, m.normal_texture);
+    }
+    float specular = (frame.flags & FLAG_SPECULAR) != 0u ? dot(m.specular.rgb, vec3(1.0 / 3.0)) : 0.0;
+    out_albedo = vec4(material_albedo(m, in_uv), specular);
+    out_normal = vec4(n, m.specular.a);
+    out_emission = vec4(front ? m.emission.rgb : vec3(0.0), 0.0);
+}

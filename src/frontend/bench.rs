@@ -1,0 +1,160 @@
+//! `voxcone bench`: renders frames headless and reports GPU time per pass.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use anyhow::{Context as _, Result};
+use ash::vk;
+use serde::Serialize;
+
+use super::{check_validation, create_context, load_scene, Offscreen};
+use crate::cli::BenchArgs;
+use crate::renderer::{OutputTarget, Renderer};
+use crate::vk::ImageUse;
+
+#[derive(Serialize, Debug, Clone, Copy)]
+pub struct PassStats {
+    pub median_ms: f64,
+    pub min_ms: f64,
+    pub max_ms: f64,
+}
+
+#[derive(Serialize, Debug)]
+pub struct BenchReport {
+    pub device: String,
+    pub driver: String,
+    pub scene: String,
+    pub size: [u32; 2],
+    pub frames: u32,
+    /// Passes in frame order (the JSON map is keyed by name).
+    #[serde(skip)]
+    pub order: Vec<String>,
+    pub passes: BTreeMap<String, PassStats>,
+    pub total_median_ms: f64,
+    /// Median host time between frame starts, with the host waiting for each frame.
+    pub wall_median_ms: f64,
+    pub memory_mib: BTreeMap<String, f64>,
+    pub stats: BTreeMap<String, f64>,
+}
+
+pub fn median(values: &mut [f64]) -> f64 {
+    values.sort_by(|a, b| a.total_cmp(b));
+    let n = values.len();
+    if n == 0 {
+        0.0
+    } else if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+fn stats(values: &[f64]) -> PassStats {
+    let mut sorted = values.to_vec();
+    PassStats {
+        median_ms: median(&mut sorted),
+        min_ms: sorted.first().copied().unwrap_or(0.0),
+        max_ms: sorted.last().copied().unwrap_or(0.0),
+    }
+}
+
+pub fn run(args: &BenchArgs) -> Result<BenchReport> {
+    let ctx = create_context(&args.common, Vec::new())?;
+    let scene = load_scene(&args.common)?;
+    let triangles = scene.triangle_count;
+    let extent = vk::Extent2D {
+        width: args.size.0,
+        height: args.size.1,
+    };
+    let offscreen = Offscreen::new(&ctx, extent)?;
+    let mut renderer = Renderer::new(
+        &ctx,
+        scene,
+        args.common.render_settings(),
+        extent,
+        super::LDR_FORMAT,
+    )?;
+    let target = OutputTarget {
+        image: offscreen.image.raw,
+        view: offscreen.image.view,
+        extent,
+        before: ImageUse::discard_after(ImageUse::COLOR_ATTACHMENT),
+        after: ImageUse::COLOR_ATTACHMENT,
+    };
+    let mut order: Vec<String> = Vec::new();
+    let mut samples: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    let mut totals = Vec::new();
+    let mut walls = Vec::new();
+    let total_frames = args.warmup + args.frames;
+    for index in 0..total_frames {
+        let start = Instant::now();
+        let frame = renderer.begin_frame()?;
+        renderer.record_frame(&frame, args.common.time, &target)?;
+        renderer.submit(frame, None, None)?;
+        // Waiting for each frame keeps frames from overlapping, so pass times are clean.
+        renderer.finish()?;
+        if index < args.warmup {
+            continue;
+        }
+        walls.push(start.elapsed().as_secs_f64() * 1e3);
+        let mut total = 0.0;
+        for (name, ms) in &renderer.timings {
+            if !order.contains(name) {
+                order.push(name.clone());
+            }
+            samples.entry(name.clone()).or_default().push(*ms);
+            total += ms;
+        }
+        totals.push(total);
+    }
+    let passes = samples
+        .iter()
+        .map(|(name, v)| (name.clone(), stats(v)))
+        .collect();
+    let mib = |bytes: u64| bytes as f64 / (1024.0 * 1024.0);
+    let mut memory_mib = BTreeMap::new();
+    memory_mib.insert("scene_textures".to_string(), mib(renderer.texture_bytes()));
+    let mut stats_map = BTreeMap::new();
+    stats_map.insert("triangles".to_string(), triangles as f64);
+    let report = BenchReport {
+        device: ctx.device_name(),
+        driver: ctx.driver.clone(),
+        scene: args.common.scene_path().display().to_string(),
+        size: [extent.width, extent.height],
+        frames: args.frames,
+        order,
+        passes,
+        total_median_ms: median(&mut totals),
+        wall_median_ms: median(&mut walls),
+        memory_mib,
+        stats: stats_map,
+    };
+    print_table(&report);
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&report)?;
+        std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    check_validation(&ctx)?;
+    Ok(report)
+}
+
+fn print_table(report: &BenchReport) {
+    println!(
+        "{} ({}), {}x{}, {} frames",
+        report.device, report.driver, report.size[0], report.size[1], report.frames
+    );
+    println!(
+        "{:<24} {:>10} {:>10} {:>10}",
+        "pass", "median ms", "min ms", "max ms"
+    );
+    for name in &report.order {
+        let s = &report.passes[name];
+        println!(
+            "{:<24} {:>10.3} {:>10.3} {:>10.3}",
+            name, s.median_ms, s.min_ms, s.max_ms
+        );
+    }
+    println!("{:<24} {:>10.3}", "total (GPU)", report.total_median_ms);
+    println!("{:<24} {:>10.3}", "wall per frame", report.wall_median_ms);
+}

@@ -1,0 +1,108 @@
+//! `voxcone render`: one frame, headless, to PNG or EXR.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{bail, Context as _, Result};
+use ash::vk;
+
+use super::{check_validation, create_context, load_scene, Offscreen};
+use crate::cli::RenderArgs;
+use crate::renderer::{copy_image_to_buffer, OutputTarget, Renderer};
+use crate::vk::{Buffer, ImageUse};
+
+enum Format {
+    Png,
+    Exr,
+}
+
+fn output_format(path: &Path) -> Result<Format> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("png") => Ok(Format::Png),
+        Some("exr") => Ok(Format::Exr),
+        _ => bail!(
+            "output {} must end in .png (tonemapped sRGB) or .exr (linear radiance)",
+            path.display()
+        ),
+    }
+}
+
+/// Renders one frame and writes it; returns the path written.
+pub fn run(args: &RenderArgs) -> Result<PathBuf> {
+    let format = output_format(&args.output)?;
+    let ctx = create_context(&args.common, Vec::new())?;
+    let scene = load_scene(&args.common)?;
+    let extent = vk::Extent2D {
+        width: args.size.0,
+        height: args.size.1,
+    };
+    let offscreen = Offscreen::new(&ctx, extent)?;
+    let mut renderer = Renderer::new(
+        &ctx,
+        scene,
+        args.common.render_settings(),
+        extent,
+        super::LDR_FORMAT,
+    )?;
+    let radiance = Buffer::new(
+        &ctx,
+        "radiance readback",
+        u64::from(extent.width) * u64::from(extent.height) * 16,
+        vk::BufferUsageFlags::TRANSFER_DST,
+        gpu_allocator::MemoryLocation::GpuToCpu,
+    )?;
+    let start = Instant::now();
+    let target = OutputTarget {
+        image: offscreen.image.raw,
+        view: offscreen.image.view,
+        extent,
+        before: ImageUse::UNDEFINED,
+        after: ImageUse::TRANSFER_SRC,
+    };
+    let frame = renderer.begin_frame()?;
+    renderer.record_frame(&frame, args.common.time, &target)?;
+    match format {
+        Format::Exr => renderer.record_radiance_readback(frame.cmd, &radiance),
+        Format::Png => copy_image_to_buffer(
+            &ctx,
+            frame.cmd,
+            offscreen.image.raw,
+            extent,
+            offscreen.readback.raw,
+        ),
+    }
+    renderer.submit(frame, None, None)?;
+    renderer.finish()?;
+    log::info!(
+        "rendered {}x{} in {:.1} ms (GPU: {})",
+        extent.width,
+        extent.height,
+        start.elapsed().as_secs_f64() * 1e3,
+        renderer
+            .timings
+            .iter()
+            .map(|(name, ms)| format!("{name} {ms:.2} ms"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    match format {
+        Format::Exr => {
+            let data: &[f32] = bytemuck::cast_slice(radiance.mapped());
+            crate::imageio::write_exr(&args.output, extent.width, extent.height, data)
+        }
+        Format::Png => crate::imageio::write_png(
+            &args.output,
+            extent.width,
+            extent.height,
+            offscreen.readback.mapped(),
+        ),
+    }
+    .with_context(|| format!("writing {}", args.output.display()))?;
+    check_validation(&ctx)?;
+    Ok(args.output.clone())
+}

@@ -1,0 +1,429 @@
+//! `voxcone view`: a window with the live renderer.
+//!
+//! Controls: drag with the left mouse button to look around, W/A/S/D to move, Q/E to
+//! go down/up, Shift to move faster; arrow keys move the first light in X/Z and
+//! PageUp/PageDown in Y; G cycles the GI method; Escape quits.
+
+use std::collections::HashSet;
+use std::ffi::CStr;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{anyhow, Context as _, Result};
+use ash::vk;
+use glam::{Quat, Vec3};
+use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, MouseButton, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::window::{Window, WindowId};
+
+use super::{check_validation, create_context, load_scene};
+use crate::cli::ViewArgs;
+use crate::renderer::{copy_image_to_buffer, OutputTarget, Renderer};
+use crate::vk::{Acquired, Buffer, Context, ImageUse, Swapchain};
+
+/// Everything that exists while the window is open.
+struct Viewer {
+    renderer: Renderer,
+    swapchain: Swapchain,
+    /// One per frame slot: signalled when the slot's swapchain image is acquired.
+    acquired: Vec<vk::Semaphore>,
+    window: Arc<Window>,
+    ctx: Arc<Context>,
+    needs_resize: bool,
+    /// Scene extent used to scale camera and light speed.
+    scene_size: f32,
+}
+
+struct App {
+    args: ViewArgs,
+    viewer: Option<Viewer>,
+    error: Option<anyhow::Error>,
+    frames: u64,
+    start: Instant,
+    last_tick: Instant,
+    last_title: Instant,
+    keys: HashSet<KeyCode>,
+    dragging: bool,
+    cursor: Option<(f64, f64)>,
+}
+
+pub fn run(args: ViewArgs) -> Result<()> {
+    let event_loop = EventLoop::new().map_err(|e| {
+        anyhow!("cannot open a window ({e}); is a display available (DISPLAY/WAYLAND_DISPLAY)? `voxcone render` works without one")
+    })?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = App {
+        args,
+        viewer: None,
+        error: None,
+        frames: 0,
+        start: Instant::now(),
+        last_tick: Instant::now(),
+        last_title: Instant::now(),
+        keys: HashSet::new(),
+        dragging: false,
+        cursor: None,
+    };
+    event_loop.run_app(&mut app).context("window event loop")?;
+    if let Some(error) = app.error.take() {
+        return Err(error);
+    }
+    if let Some(viewer) = app.viewer.take() {
+        let ctx = viewer.ctx.clone();
+        drop(viewer);
+        check_validation(&ctx)?;
+    }
+    Ok(())
+}
+
+impl Viewer {
+    fn new(args: &ViewArgs, event_loop: &ActiveEventLoop) -> Result<Self> {
+        let (width, height) = args.size;
+        let attributes = Window::default_attributes()
+            .with_title("voxcone")
+            .with_inner_size(winit::dpi::PhysicalSize::new(width, height));
+        let window = Arc::new(
+            event_loop
+                .create_window(attributes)
+                .context("creating the window")?,
+        );
+        let display = window.display_handle().context("display handle")?.as_raw();
+        let extensions = ash_window::enumerate_required_extensions(display)
+            .context("this window system has no Vulkan surface support")?
+            .iter()
+            // SAFETY: ash-window returns pointers to static, NUL-terminated names.
+            .map(|&name| unsafe { CStr::from_ptr(name) })
+            .collect();
+        let ctx = create_context(&args.common, extensions)?;
+        let surface = unsafe {
+            ash_window::create_surface(
+                &ctx.entry,
+                &ctx.instance,
+                display,
+                window.window_handle().context("window handle")?.as_raw(),
+                None,
+            )
+        }
+        .context("creating the window surface")?;
+        let size = window.inner_size();
+        let extent = vk::Extent2D {
+            width: size.width.max(1),
+            height: size.height.max(1),
+        };
+        let swapchain = Swapchain::new(&ctx, surface, extent)?;
+        let scene = load_scene(&args.common)?;
+        let bounds = scene.bounds(0.0);
+        let scene_size = (bounds.max - bounds.min).length().max(1e-3);
+        let renderer = Renderer::new(
+            &ctx,
+            scene,
+            args.common.render_settings(),
+            swapchain.extent,
+            swapchain.format,
+        )?;
+        let acquired = (0..2)
+            .map(|_| unsafe {
+                ctx.device
+                    .create_semaphore(&vk::SemaphoreCreateInfo::default(), None)
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Self {
+            renderer,
+            swapchain,
+            acquired,
+            window,
+            ctx,
+            needs_resize: false,
+            scene_size,
+        })
+    }
+
+    fn resize(&mut self) -> Result<()> {
+        let size = self.window.inner_size();
+        self.renderer.finish()?;
+        self.swapchain.recreate(vk::Extent2D {
+            width: size.width.max(1),
+            height: size.height.max(1),
+        })?;
+        self.renderer.resize(self.swapchain.extent)?;
+        self.needs_resize = false;
+        Ok(())
+    }
+
+    /// Renders and presents one frame; with `screenshot`, also saves it as a PNG.
+    fn draw(&mut self, time_s: f32, screenshot: Option<&PathBuf>) -> Result<()> {
+        let size = self.window.inner_size();
+        if size.width == 0 || size.height == 0 {
+            // Minimized: nothing to present to.
+            return Ok(());
+        }
+        if self.needs_resize
+            || size.width != self.swapchain.extent.width
+            || size.height != self.swapchain.extent.height
+        {
+            self.resize()?;
+        }
+        let frame = self.renderer.begin_frame()?;
+        let acquired = self.acquired[frame.slot];
+        let index = match self.swapchain.acquire(acquired)? {
+            Acquired::Image(index, suboptimal) => {
+                self.needs_resize |= suboptimal;
+                index
+            }
+            Acquired::OutOfDate => {
+                // Nothing was acquired: submit the empty frame to keep the timeline going.
+                self.needs_resize = true;
+                return self.renderer.submit(frame, None, None);
+            }
+        };
+        let readback = screenshot.filter(|_| self.swapchain.readable);
+        let extent = self.swapchain.extent;
+        let target = OutputTarget {
+            image: self.swapchain.images[index as usize],
+            view: self.swapchain.views[index as usize],
+            extent,
+            before: ImageUse {
+                layout: vk::ImageLayout::UNDEFINED,
+                stage: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                access: vk::AccessFlags2::NONE,
+            },
+            after: if readback.is_some() {
+                ImageUse::TRANSFER_SRC
+            } else {
+                ImageUse::PRESENT
+            },
+        };
+        self.renderer.record_frame(&frame, time_s, &target)?;
+        let buffer = match readback {
+            Some(_) => {
+                let buffer = Buffer::new(
+                    &self.ctx,
+                    "screenshot",
+                    u64::from(extent.width) * u64::from(extent.height) * 4,
+                    vk::BufferUsageFlags::TRANSFER_DST,
+                    gpu_allocator::MemoryLocation::GpuToCpu,
+                )?;
+                copy_image_to_buffer(&self.ctx, frame.cmd, target.image, extent, buffer.raw);
+                crate::vk::image_barrier(
+                    &self.ctx,
+                    frame.cmd,
+                    target.image,
+                    vk::ImageSubresourceRange {
+                        aspect_mask: vk::ImageAspectFlags::COLOR,
+                        base_mip_level: 0,
+                        level_count: 1,
+                        base_array_layer: 0,
+                        layer_count: 1,
+                    },
+                    ImageUse::TRANSFER_SRC,
+                    ImageUse::PRESENT,
+                );
+                Some(buffer)
+            }
+            None => None,
+        };
+        self.renderer.submit(
+            frame,
+            Some((acquired, vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)),
+            Some(self.swapchain.rendered[index as usize]),
+        )?;
+        if !self.swapchain.present(index)? {
+            self.needs_resize = true;
+        }
+        if let (Some(path), Some(buffer)) = (readback, buffer) {
+            self.renderer.finish()?;
+            let mut pixels = buffer.mapped().to_vec();
+            if self.swapchain.format == vk::Format::B8G8R8A8_SRGB {
+                pixels.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+            }
+            crate::imageio::write_png(path, extent.width, extent.height, &pixels)?;
+            println!("screenshot: {}", path.display());
+        }
+        Ok(())
+    }
+
+    fn update_controls(&mut self, keys: &HashSet<KeyCode>, dt: f32) {
+        let camera = &mut self.renderer.camera;
+        let forward = (camera.target - camera.position).normalize_or_zero();
+        let right = forward.cross(camera.up).normalize_or_zero();
+        let speed = self.scene_size
+            * 0.25
+            * if keys.contains(&KeyCode::ShiftLeft) {
+                4.0
+            } else {
+                1.0
+            };
+        let mut motion = Vec3::ZERO;
+        for (key, direction) in [
+            (KeyCode::KeyW, forward),
+            (KeyCode::KeyS, -forward),
+            (KeyCode::KeyD, right),
+            (KeyCode::KeyA, -right),
+            (KeyCode::KeyE, camera.up),
+            (KeyCode::KeyQ, -camera.up),
+        ] {
+            if keys.contains(&key) {
+                motion += direction;
+            }
+        }
+        let step = motion * speed * dt;
+        camera.position += step;
+        camera.target += step;
+
+        let mut light_motion = Vec3::ZERO;
+        for (key, direction) in [
+            (KeyCode::ArrowLeft, Vec3::NEG_X),
+            (KeyCode::ArrowRight, Vec3::X),
+            (KeyCode::ArrowUp, Vec3::NEG_Z),
+            (KeyCode::ArrowDown, Vec3::Z),
+            (KeyCode::PageUp, Vec3::Y),
+            (KeyCode::PageDown, Vec3::NEG_Y),
+        ] {
+            if keys.contains(&key) {
+                light_motion += direction;
+            }
+        }
+        if let Some(light) = self.renderer.scene.lights.first_mut() {
+            light.position += light_motion * self.scene_size * 0.15 * dt;
+        }
+    }
+
+    fn look(&mut self, dx: f32, dy: f32) {
+        let camera = &mut self.renderer.camera;
+        let forward = camera.target - camera.position;
+        let distance = forward.length().max(1e-4);
+        let right = forward.cross(camera.up).normalize_or_zero();
+        let yaw = Quat::from_axis_angle(camera.up.normalize_or_zero(), -dx * 0.004);
+        let pitch = Quat::from_axis_angle(right, -dy * 0.004);
+        let turned = (yaw * pitch * forward).normalize_or_zero();
+        // Stop short of looking straight up or down, where `right` degenerates.
+        if turned.dot(camera.up.normalize_or_zero()).abs() < 0.98 {
+            camera.target = camera.position + turned * distance;
+        }
+    }
+}
+
+impl Drop for Viewer {
+    fn drop(&mut self) {
+        let _ = self.renderer.finish();
+        for &semaphore in &self.acquired {
+            unsafe { self.ctx.device.destroy_semaphore(semaphore, None) };
+        }
+    }
+}
+
+impl App {
+    fn fail(&mut self, event_loop: &ActiveEventLoop, error: anyhow::Error) {
+        self.error = Some(error);
+        event_loop.exit();
+    }
+
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(viewer) = self.viewer.as_mut() else {
+            return;
+        };
+        let now = Instant::now();
+        let dt = (now - self.last_tick).as_secs_f32().min(0.25);
+        self.last_tick = now;
+        viewer.update_controls(&self.keys, dt);
+        let last = self.args.frames.is_some_and(|n| self.frames + 1 >= n);
+        let screenshot = if last {
+            self.args.screenshot.as_ref()
+        } else {
+            None
+        };
+        let time_s = (now - self.start).as_secs_f32() + self.args.common.time;
+        if let Err(e) = viewer.draw(time_s, screenshot) {
+            self.fail(event_loop, e);
+            return;
+        }
+        self.frames += 1;
+        if now.duration_since(self.last_title).as_secs_f32() > 0.5 {
+            self.last_title = now;
+            let passes: Vec<String> = viewer
+                .renderer
+                .timings
+                .iter()
+                .map(|(name, ms)| format!("{name} {ms:.1}"))
+                .collect();
+            viewer.window.set_title(&format!(
+                "voxcone, {:.1} ms/frame dt, GPU ms: {}",
+                dt * 1e3,
+                passes.join(" ")
+            ));
+        }
+        if last {
+            event_loop.exit();
+        }
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.viewer.is_none() {
+            match Viewer::new(&self.args, event_loop) {
+                Ok(viewer) => {
+                    self.start = Instant::now();
+                    self.last_tick = self.start;
+                    self.viewer = Some(viewer);
+                }
+                Err(e) => self.fail(event_loop, e),
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(_) => {
+                if let Some(viewer) = self.viewer.as_mut() {
+                    viewer.needs_resize = true;
+                }
+            }
+            WindowEvent::KeyboardInput { event, .. } => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    match event.state {
+                        ElementState::Pressed => {
+                            if code == KeyCode::Escape {
+                                event_loop.exit();
+                            } else if code == KeyCode::KeyG && !event.repeat {
+                                log::info!("GI method: off (the only one so far)");
+                            }
+                            self.keys.insert(code);
+                        }
+                        ElementState::Released => {
+                            self.keys.remove(&code);
+                        }
+                    }
+                }
+            }
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => {
+                self.dragging = state == ElementState::Pressed;
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                if let (Some((x, y)), true, Some(viewer)) =
+                    (self.cursor, self.dragging, self.viewer.as_mut())
+                {
+                    viewer.look((position.x - x) as f32, (position.y - y) as f32);
+                }
+                self.cursor = Some((position.x, position.y));
+            }
+            WindowEvent::RedrawRequested => self.redraw(event_loop),
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Some(viewer) = &self.viewer {
+            viewer.window.request_redraw();
+        }
+    }
+}

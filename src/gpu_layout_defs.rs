@@ -1,0 +1,152 @@
+gpu_layout! {
+    constants {
+        /// Descriptor set: per-frame data (uniforms, lights, shadow maps).
+        SET_FRAME = 0;
+        /// Descriptor set: the scene's materials and textures.
+        SET_SCENE = 1;
+        /// Descriptor set: inputs and outputs of one pass.
+        SET_PASS = 2;
+
+        /// set 0: `FrameUniforms` uniform buffer.
+        BINDING_FRAME_UNIFORMS = 0;
+        /// set 0: `GpuLight[]` storage buffer.
+        BINDING_LIGHTS = 1;
+        /// set 0: `ShadowView[]` storage buffer.
+        BINDING_SHADOW_VIEWS = 2;
+        /// set 0: shadow map layers, `sampler2DArrayShadow`.
+        BINDING_SHADOW_MAP = 3;
+
+        /// set 1: `GpuMaterial[]` storage buffer.
+        BINDING_MATERIALS = 0;
+        /// set 1: `texture2D textures[MAX_TEXTURES]`.
+        BINDING_TEXTURES = 1;
+        /// set 1: the `sampler` for material textures.
+        BINDING_MATERIAL_SAMPLER = 2;
+        /// Size of the texture array; unused slots hold a 1x1 white texture. Lavapipe
+        /// allows 128 sampled images per stage, and passes need a few of their own.
+        MAX_TEXTURES = 96;
+        /// A material's texture index meaning "no texture".
+        NO_TEXTURE = 0xFFFFFFFF;
+
+        /// lighting pass (set 2): G-buffer albedo, `rgba8` storage image.
+        BINDING_LIGHTING_ALBEDO = 0;
+        /// lighting pass (set 2): G-buffer normal + roughness, `rgba16f` storage image.
+        BINDING_LIGHTING_NORMAL = 1;
+        /// lighting pass (set 2): G-buffer emission + specular, `rgba16f` storage image.
+        BINDING_LIGHTING_EMISSION = 2;
+        /// lighting pass (set 2): depth, `sampler2D`.
+        BINDING_LIGHTING_DEPTH = 3;
+        /// lighting pass (set 2): HDR radiance out, `rgba32f` storage image.
+        BINDING_LIGHTING_OUT = 4;
+        /// Workgroup edge of the 2D compute passes.
+        SCREEN_GROUP_SIZE = 8;
+
+        /// composite pass (set 2): HDR radiance in, `sampler2D`.
+        BINDING_COMPOSITE_HDR = 0;
+
+        /// `GpuLight.kind`: point light, intensity in W/sr.
+        LIGHT_POINT = 0;
+        /// `GpuLight.kind`: spot light, intensity in W/sr on its axis.
+        LIGHT_SPOT = 1;
+        /// `GpuLight.kind`: directional light, irradiance in W/m^2.
+        LIGHT_DIRECTIONAL = 2;
+
+        /// `FrameUniforms.flags`: add the specular lobe.
+        FLAG_SPECULAR = 1;
+        /// `FrameUniforms.flags`: use tangent-space normal maps.
+        FLAG_NORMAL_MAPS = 2;
+        /// `FrameUniforms.flags`: filmic (ACES) tonemap instead of a plain clamp.
+        FLAG_TONEMAP_ACES = 4;
+
+    }
+
+    /// Per-frame constants.
+    struct FrameUniforms {
+        /// World to view.
+        mat4 view,
+        /// View to clip (Vulkan depth 0..1, row 0 at the top).
+        mat4 proj,
+        /// World to clip.
+        mat4 view_proj,
+        /// Clip to world.
+        mat4 inv_view_proj,
+        /// xyz camera position, w time in seconds.
+        vec4 camera_position,
+        /// rgb constant sky radiance, w exposure as a linear scale.
+        vec4 sky_radiance,
+        /// Render target width in pixels.
+        uint width,
+        /// Render target height in pixels.
+        uint height,
+        /// Number of entries in the light buffer.
+        uint light_count,
+        /// `FLAG_*` bits.
+        uint flags,
+    }
+
+    /// One light.
+    struct GpuLight {
+        /// xyz position (point, spot).
+        vec4 position,
+        /// rgb W/sr (point, spot) or W/m^2 (directional).
+        vec4 intensity,
+        /// xyz direction of travel (directional) or spot axis; w cosine of the outer angle.
+        vec4 direction,
+        /// `LIGHT_*`.
+        uint kind,
+        /// First `ShadowView` of this light.
+        uint first_shadow_view,
+        /// Number of shadow views: 0 (no shadow), 1 (spot, directional) or 6 (point).
+        uint shadow_view_count,
+        /// Cosine of the spot's inner angle.
+        float cos_inner,
+    }
+
+    /// One shadow-map layer: a camera looking from a light.
+    struct ShadowView {
+        /// World to the layer's clip space.
+        mat4 view_proj,
+        /// xyz light position or, for orthographic views, the direction of travel; w 1 if orthographic.
+        vec4 origin,
+        /// World size of one texel at distance 1 (perspective) or everywhere (orthographic).
+        float texel_size,
+        /// Shadow map layer index.
+        uint layer,
+        /// Near plane distance (perspective).
+        float near,
+        /// Far plane distance (perspective).
+        float far,
+    }
+
+    /// One material.
+    struct GpuMaterial {
+        /// rgb Kd albedo, a dissolve (opacity).
+        vec4 albedo,
+        /// rgb Ks, a roughness.
+        vec4 specular,
+        /// rgb emitted radiance, a index of refraction.
+        vec4 emission,
+        /// Albedo texture or `NO_TEXTURE`.
+        uint albedo_texture,
+        /// Cut-out coverage texture or `NO_TEXTURE`.
+        uint coverage_texture,
+        /// Tangent-space normal map or `NO_TEXTURE`.
+        uint normal_texture,
+        /// Unused, keeps the struct a multiple of 16 bytes.
+        uint pad,
+    }
+
+    /// Push constants of every mesh draw.
+    struct DrawPush {
+        /// Object to world.
+        mat4 model,
+        /// Index into the material buffer.
+        uint material,
+        /// Index into the shadow view buffer (shadow pass only).
+        uint shadow_view,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+    }
+}

@@ -1,0 +1,553 @@
+//! The frame: the passes in the order data flows through them.
+//!
+//! shadow maps -> G-buffer -> deferred direct lighting -> composite (tonemap to output)
+
+use std::sync::Arc;
+
+use anyhow::Result;
+use ash::vk;
+use glam::Vec3;
+use gpu_allocator::MemoryLocation;
+
+use crate::composite::CompositePass;
+use crate::gbuffer::{GBuffer, GBufferPass};
+use crate::gpu_layout::{self as layout, FrameUniforms, GpuLight, ShadowView};
+use crate::lighting::LightingPass;
+use crate::scene::{Camera, LightKind, Scene};
+use crate::scene_gpu::GpuScene;
+use crate::shadow::{self, ShadowPass};
+use crate::vk::{
+    image_barrier, memory_barrier, Binding, Buffer, Context, DescriptorSets, Frame, FrameRing,
+    GpuTimer, Image, ImageUse, Sampler, SetWriter,
+};
+
+/// How the final image is mapped to the display.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Tonemap {
+    /// clamp(x), then sRGB: the convention of the reference PNGs.
+    #[default]
+    Clamp,
+    /// Filmic curve (Narkowicz's ACES fit), then sRGB.
+    Aces,
+}
+
+/// Settings that change what a frame computes.
+#[derive(Clone, Debug)]
+pub struct RenderSettings {
+    /// Add the specular lobe of MTL Ks.
+    pub specular: bool,
+    /// Use tangent-space normal maps.
+    pub normal_maps: bool,
+    /// Exposure in stops applied before the tonemap (not to EXR output).
+    pub exposure_ev: f32,
+    pub tonemap: Tonemap,
+    /// Edge of each shadow map layer in texels.
+    pub shadow_resolution: u32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            specular: true,
+            normal_maps: true,
+            exposure_ev: 0.0,
+            tonemap: Tonemap::Clamp,
+            shadow_resolution: 1024,
+        }
+    }
+}
+
+/// Where a frame's composite goes.
+#[derive(Clone, Copy, Debug)]
+pub struct OutputTarget {
+    pub image: vk::Image,
+    pub view: vk::ImageView,
+    pub extent: vk::Extent2D,
+    /// Its state before the frame (layout UNDEFINED: contents are overwritten).
+    pub before: ImageUse,
+    /// The state to leave it in.
+    pub after: ImageUse,
+}
+
+/// Per-frame-in-flight data written by the host.
+struct FrameData {
+    uniforms: Buffer,
+    lights: Buffer,
+    shadow_views: Buffer,
+    set: vk::DescriptorSet,
+    timer: GpuTimer,
+}
+
+/// Screen-sized images, recreated on resize.
+struct Targets {
+    gbuffer: GBuffer,
+    radiance: Image,
+}
+
+pub struct Renderer {
+    pub scene: Scene,
+    pub camera: Camera,
+    pub settings: RenderSettings,
+    /// GPU milliseconds per pass of the last completed frame.
+    pub timings: Vec<(String, f64)>,
+    targets: Targets,
+    radiance_last_use: ImageUse,
+    composite: CompositePass,
+    lighting: LightingPass,
+    gbuffer_pass: GBufferPass,
+    shadow: ShadowPass,
+    frames: Vec<FrameData>,
+    /// Owns the frame descriptor sets.
+    _frame_sets: DescriptorSets,
+    ring: FrameRing,
+    gpu: GpuScene,
+    nearest_sampler: Sampler,
+    /// Referenced by the frame descriptor sets.
+    _shadow_sampler: Sampler,
+    ctx: Arc<Context>,
+}
+
+const FRAMES_IN_FLIGHT: usize = 2;
+
+fn frame_bindings() -> [Binding; 4] {
+    let all = vk::ShaderStageFlags::ALL;
+    [
+        Binding::new(
+            layout::BINDING_FRAME_UNIFORMS,
+            vk::DescriptorType::UNIFORM_BUFFER,
+            all,
+        ),
+        Binding::new(
+            layout::BINDING_LIGHTS,
+            vk::DescriptorType::STORAGE_BUFFER,
+            all,
+        ),
+        Binding::new(
+            layout::BINDING_SHADOW_VIEWS,
+            vk::DescriptorType::STORAGE_BUFFER,
+            all,
+        ),
+        Binding::new(
+            layout::BINDING_SHADOW_MAP,
+            vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+            all,
+        ),
+    ]
+}
+
+impl Renderer {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: Scene,
+        settings: RenderSettings,
+        extent: vk::Extent2D,
+        output_format: vk::Format,
+    ) -> Result<Self> {
+        let gpu = GpuScene::new(ctx, &scene)?;
+        let frame_sets =
+            DescriptorSets::new(ctx, "frame", &frame_bindings(), FRAMES_IN_FLIGHT as u32)?;
+        let set_layouts = [frame_sets.layout, gpu.sets.layout];
+        let shadow = ShadowPass::new(ctx, &scene, settings.shadow_resolution, &set_layouts)?;
+        let gbuffer_pass = GBufferPass::new(ctx, &set_layouts)?;
+        let lighting = LightingPass::new(ctx, set_layouts)?;
+        let composite = CompositePass::new(ctx, set_layouts, output_format)?;
+        let nearest_sampler = Sampler::new(
+            ctx,
+            "nearest",
+            &vk::SamplerCreateInfo::default()
+                .mag_filter(vk::Filter::NEAREST)
+                .min_filter(vk::Filter::NEAREST)
+                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE),
+        )?;
+        // Outside a shadow map's coverage reads as lit (border depth 1).
+        let shadow_sampler = Sampler::new(
+            ctx,
+            "shadow compare",
+            &vk::SamplerCreateInfo::default()
+                .mag_filter(vk::Filter::LINEAR)
+                .min_filter(vk::Filter::LINEAR)
+                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_BORDER)
+                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_BORDER)
+                .border_color(vk::BorderColor::FLOAT_OPAQUE_WHITE)
+                .compare_enable(true)
+                .compare_op(vk::CompareOp::LESS_OR_EQUAL),
+        )?;
+        let light_slots = scene.lights.len().max(1);
+        let view_slots: u32 = scene
+            .lights
+            .iter()
+            .map(shadow::view_count)
+            .sum::<u32>()
+            .max(1);
+        let mut frames = Vec::new();
+        for i in 0..FRAMES_IN_FLIGHT {
+            let uniforms = Buffer::new(
+                ctx,
+                &format!("frame uniforms {i}"),
+                std::mem::size_of::<FrameUniforms>() as u64,
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?;
+            let lights = Buffer::new(
+                ctx,
+                &format!("lights {i}"),
+                (std::mem::size_of::<GpuLight>() * light_slots) as u64,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?;
+            let shadow_views = Buffer::new(
+                ctx,
+                &format!("shadow views {i}"),
+                (std::mem::size_of::<ShadowView>() * view_slots as usize) as u64,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?;
+            let set = frame_sets.allocate(&format!("frame {i}"))?;
+            SetWriter::new(ctx, set)
+                .buffer(
+                    layout::BINDING_FRAME_UNIFORMS,
+                    vk::DescriptorType::UNIFORM_BUFFER,
+                    uniforms.raw,
+                )
+                .buffer(
+                    layout::BINDING_LIGHTS,
+                    vk::DescriptorType::STORAGE_BUFFER,
+                    lights.raw,
+                )
+                .buffer(
+                    layout::BINDING_SHADOW_VIEWS,
+                    vk::DescriptorType::STORAGE_BUFFER,
+                    shadow_views.raw,
+                )
+                .sampled_image(
+                    layout::BINDING_SHADOW_MAP,
+                    shadow.map.view,
+                    shadow_sampler.raw,
+                    vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
+                )
+                .apply();
+            frames.push(FrameData {
+                uniforms,
+                lights,
+                shadow_views,
+                set,
+                timer: GpuTimer::new(ctx)?,
+            });
+        }
+        let targets = Self::create_targets(ctx, extent)?;
+        let renderer = Self {
+            camera: scene.camera.clone(),
+            scene,
+            settings,
+            timings: Vec::new(),
+            targets,
+            radiance_last_use: ImageUse::FRAGMENT_READ,
+            composite,
+            lighting,
+            gbuffer_pass,
+            shadow,
+            frames,
+            _frame_sets: frame_sets,
+            ring: FrameRing::new(ctx, FRAMES_IN_FLIGHT)?,
+            gpu,
+            nearest_sampler,
+            _shadow_sampler: shadow_sampler,
+            ctx: ctx.clone(),
+        };
+        renderer.bind_targets();
+        Ok(renderer)
+    }
+
+    fn create_targets(ctx: &Arc<Context>, extent: vk::Extent2D) -> Result<Targets> {
+        Ok(Targets {
+            gbuffer: GBuffer::new(ctx, extent)?,
+            radiance: LightingPass::create_output(ctx, extent)?,
+        })
+    }
+
+    fn bind_targets(&self) {
+        let t = &self.targets;
+        self.lighting
+            .bind_targets(&self.ctx, &t.gbuffer, &t.radiance, self.nearest_sampler.raw);
+        self.composite
+            .bind_input(&self.ctx, &t.radiance, self.nearest_sampler.raw);
+    }
+
+    pub fn context(&self) -> &Arc<Context> {
+        &self.ctx
+    }
+
+    pub fn extent(&self) -> vk::Extent2D {
+        self.targets.gbuffer.extent()
+    }
+
+    /// Bytes of GPU memory held by scene textures.
+    pub fn texture_bytes(&self) -> u64 {
+        self.gpu.texture_bytes()
+    }
+
+    /// Recreates the screen-sized images; waits for frames in flight first.
+    pub fn resize(&mut self, extent: vk::Extent2D) -> Result<()> {
+        self.ring.wait_all()?;
+        self.targets = Self::create_targets(&self.ctx, extent)?;
+        self.radiance_last_use = ImageUse::FRAGMENT_READ;
+        self.bind_targets();
+        Ok(())
+    }
+
+    fn frame_uniforms(&self, time_s: f32) -> FrameUniforms {
+        let extent = self.extent();
+        let aspect = extent.width as f32 / extent.height as f32;
+        let view = self.camera.view();
+        let proj = self.camera.proj(aspect);
+        let view_proj = proj * view;
+        let s = &self.settings;
+        let mut flags = 0;
+        if s.specular {
+            flags |= layout::FLAG_SPECULAR;
+        }
+        if s.normal_maps {
+            flags |= layout::FLAG_NORMAL_MAPS;
+        }
+        if s.tonemap == Tonemap::Aces {
+            flags |= layout::FLAG_TONEMAP_ACES;
+        }
+        FrameUniforms {
+            view: view.to_cols_array_2d(),
+            proj: proj.to_cols_array_2d(),
+            view_proj: view_proj.to_cols_array_2d(),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            camera_position: self.camera.position.extend(time_s).to_array(),
+            sky_radiance: self.scene.sky.extend(2f32.powf(s.exposure_ev)).to_array(),
+            width: extent.width,
+            height: extent.height,
+            light_count: self.scene.lights.len() as u32,
+            flags,
+        }
+    }
+
+    fn gpu_lights(&self, time_s: f32) -> Vec<GpuLight> {
+        let mut first_view = 0;
+        (0..self.scene.lights.len())
+            .map(|i| {
+                let light = self.scene.light_at(i, time_s);
+                let views = shadow::view_count(&light);
+                let (kind, direction, cos_outer, cos_inner) = match light.kind {
+                    LightKind::Point => (layout::LIGHT_POINT, Vec3::ZERO, -1.0, -1.0),
+                    LightKind::Spot {
+                        direction,
+                        inner_deg,
+                        outer_deg,
+                    } => (
+                        layout::LIGHT_SPOT,
+                        direction.normalize(),
+                        outer_deg.to_radians().cos(),
+                        inner_deg.to_radians().cos(),
+                    ),
+                    LightKind::Directional { direction } => {
+                        (layout::LIGHT_DIRECTIONAL, direction.normalize(), -1.0, -1.0)
+                    }
+                };
+                let gpu = GpuLight {
+                    position: light.position.extend(1.0).to_array(),
+                    intensity: light.intensity.extend(0.0).to_array(),
+                    direction: direction.extend(cos_outer).to_array(),
+                    kind,
+                    first_shadow_view: first_view,
+                    shadow_view_count: views,
+                    cos_inner,
+                };
+                first_view += views;
+                gpu
+            })
+            .collect()
+    }
+
+    /// Waits until a frame slot is free and starts its command buffer.
+    pub fn begin_frame(&mut self) -> Result<Frame> {
+        let frame = self.ring.begin()?;
+        // The slot's previous frame has completed (ring.begin waited for it).
+        if frame.value > self.ring.frames_in_flight() as u64 {
+            self.timings = self.frames[frame.slot].timer.results()?;
+        }
+        Ok(frame)
+    }
+
+    /// Records every pass of the frame at scene time `time_s`, ending in `output`. The
+    /// command buffer stays open for the caller (read-backs); then call [`Self::submit`].
+    pub fn record_frame(
+        &mut self,
+        frame: &Frame,
+        time_s: f32,
+        output: &OutputTarget,
+    ) -> Result<()> {
+        let ctx = self.ctx.clone();
+        let cmd = frame.cmd;
+        let uniforms = self.frame_uniforms(time_s);
+        let lights = self.gpu_lights(time_s);
+        let views: Vec<ShadowView> =
+            shadow::scene_views(&self.scene, time_s, self.settings.shadow_resolution);
+        let data = &mut self.frames[frame.slot];
+        data.uniforms.write(0, bytemuck::bytes_of(&uniforms));
+        data.lights.write(0, bytemuck::cast_slice(&lights));
+        data.shadow_views.write(0, bytemuck::cast_slice(&views));
+        let data = &mut self.frames[frame.slot];
+        let sets = [
+            (layout::SET_FRAME, data.set),
+            (layout::SET_SCENE, self.gpu.set),
+        ];
+        let timer = &mut data.timer;
+        timer.reset(cmd);
+
+        timer.begin(cmd, "shadow");
+        self.shadow
+            .record(&ctx, cmd, &self.scene, &self.gpu, &sets, &views, time_s);
+        timer.end(cmd);
+
+        timer.begin(cmd, "gbuffer");
+        self.gbuffer_pass.record(
+            &ctx,
+            cmd,
+            &self.targets.gbuffer,
+            &self.scene,
+            &self.gpu,
+            &sets,
+            time_s,
+        );
+        timer.end(cmd);
+
+        timer.begin(cmd, "lighting");
+        self.lighting.record(
+            &ctx,
+            cmd,
+            data.set,
+            &self.targets.radiance,
+            self.radiance_last_use,
+        );
+        timer.end(cmd);
+
+        timer.begin(cmd, "composite");
+        image_barrier(
+            &ctx,
+            cmd,
+            self.targets.radiance.raw,
+            self.targets.radiance.full_range(),
+            ImageUse::COMPUTE_WRITE,
+            ImageUse::FRAGMENT_READ,
+        );
+        self.radiance_last_use = ImageUse::FRAGMENT_READ;
+        let range = vk::ImageSubresourceRange {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        image_barrier(
+            &ctx,
+            cmd,
+            output.image,
+            range,
+            output.before,
+            ImageUse::COLOR_ATTACHMENT,
+        );
+        self.composite
+            .record(&ctx, cmd, data.set, output.view, output.extent);
+        image_barrier(
+            &ctx,
+            cmd,
+            output.image,
+            range,
+            ImageUse::COLOR_ATTACHMENT,
+            output.after,
+        );
+        timer.end(cmd);
+        Ok(())
+    }
+
+    /// Copies the frame's HDR radiance (RGBA32F) into `buffer`, which must hold
+    /// width x height x 16 bytes and be host visible.
+    pub fn record_radiance_readback(&mut self, cmd: vk::CommandBuffer, buffer: &Buffer) {
+        let radiance = &self.targets.radiance;
+        image_barrier(
+            &self.ctx,
+            cmd,
+            radiance.raw,
+            radiance.full_range(),
+            self.radiance_last_use,
+            ImageUse::TRANSFER_SRC,
+        );
+        self.radiance_last_use = ImageUse::TRANSFER_SRC;
+        copy_image_to_buffer(
+            &self.ctx,
+            cmd,
+            radiance.raw,
+            radiance.extent_2d(),
+            buffer.raw,
+        );
+    }
+
+    pub fn submit(
+        &mut self,
+        frame: Frame,
+        wait: Option<(vk::Semaphore, vk::PipelineStageFlags2)>,
+        signal: Option<vk::Semaphore>,
+    ) -> Result<()> {
+        self.ring.submit(frame, wait, signal)
+    }
+
+    /// Waits for every submitted frame and collects the last one's pass times.
+    pub fn finish(&mut self) -> Result<()> {
+        self.ring.wait_all()?;
+        if let Some(slot) = self.ring.last_slot() {
+            self.timings = self.frames[slot].timer.results()?;
+        }
+        Ok(())
+    }
+}
+
+/// Records a copy of mip 0, layer 0 of a colour image in TRANSFER_SRC layout to `buffer`.
+pub fn copy_image_to_buffer(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    extent: vk::Extent2D,
+    buffer: vk::Buffer,
+) {
+    let region = vk::BufferImageCopy {
+        buffer_offset: 0,
+        buffer_row_length: 0,
+        buffer_image_height: 0,
+        image_subresource: vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        },
+        image_offset: vk::Offset3D::default(),
+        image_extent: vk::Extent3D {
+            width: extent.width,
+            height: extent.height,
+            depth: 1,
+        },
+    };
+    unsafe {
+        ctx.device.cmd_copy_image_to_buffer(
+            cmd,
+            image,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            buffer,
+            &[region],
+        )
+    };
+    memory_barrier(
+        ctx,
+        cmd,
+        (
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+        ),
+        (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+    );
+}

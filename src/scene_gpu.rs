@@ -1,0 +1,308 @@
+//! The scene on the GPU: one vertex and index buffer, materials, textures with mips, and
+//! the descriptor set (set 1) that shaders read them through.
+
+use std::sync::Arc;
+
+use anyhow::{bail, Result};
+use ash::vk;
+
+use crate::gpu_layout::{self as layout, GpuMaterial};
+use crate::scene::{Scene, TextureKind, Vertex};
+use crate::vk::{
+    image_barrier, upload_buffer, Binding, Buffer, Context, DescriptorSets, Image, ImageDesc,
+    ImageUse, OneShot, Sampler, SetWriter,
+};
+
+/// One indexed draw: a mesh of the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Draw {
+    pub mesh: usize,
+    pub first_index: u32,
+    pub index_count: u32,
+    pub vertex_offset: i32,
+    pub material: u32,
+}
+
+pub struct GpuScene {
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub materials: Buffer,
+    pub draws: Vec<Draw>,
+    pub set: vk::DescriptorSet,
+    pub sets: DescriptorSets,
+    textures: Vec<Image>,
+    sampler: Sampler,
+}
+
+/// The `Vertex` attributes: (location, format, offset).
+pub const VERTEX_ATTRIBUTES: [(u32, vk::Format, u32); 3] = [
+    (0, vk::Format::R32G32B32_SFLOAT, 0),
+    (1, vk::Format::R32G32B32_SFLOAT, 12),
+    (2, vk::Format::R32G32_SFLOAT, 24),
+];
+
+fn texture_index(index: Option<u32>) -> u32 {
+    index.unwrap_or(layout::NO_TEXTURE)
+}
+
+impl GpuScene {
+    pub fn bindings() -> [Binding; 3] {
+        let stages = vk::ShaderStageFlags::ALL;
+        [
+            Binding::new(
+                layout::BINDING_MATERIALS,
+                vk::DescriptorType::STORAGE_BUFFER,
+                stages,
+            ),
+            Binding::new(
+                layout::BINDING_TEXTURES,
+                vk::DescriptorType::SAMPLED_IMAGE,
+                stages,
+            )
+            .array(layout::MAX_TEXTURES),
+            Binding::new(
+                layout::BINDING_MATERIAL_SAMPLER,
+                vk::DescriptorType::SAMPLER,
+                stages,
+            ),
+        ]
+    }
+
+    pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<Self> {
+        if scene.textures.len() >= layout::MAX_TEXTURES as usize {
+            bail!(
+                "the scene has {} textures; at most {} are supported",
+                scene.textures.len(),
+                layout::MAX_TEXTURES - 1
+            );
+        }
+        let one_shot = OneShot::new(ctx)?;
+        let mut vertices: Vec<Vertex> = Vec::new();
+        let mut indices: Vec<u32> = Vec::new();
+        let mut draws = Vec::new();
+        for (mesh_index, mesh) in scene.meshes.iter().enumerate() {
+            draws.push(Draw {
+                mesh: mesh_index,
+                first_index: indices.len() as u32,
+                index_count: mesh.indices.len() as u32,
+                vertex_offset: vertices.len() as i32,
+                material: mesh.material,
+            });
+            vertices.extend_from_slice(&mesh.vertices);
+            indices.extend_from_slice(&mesh.indices);
+        }
+        let vertex_usage =
+            vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
+        let index_usage = vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
+        let vertices = upload_buffer(
+            ctx,
+            &one_shot,
+            "scene vertices",
+            bytemuck::cast_slice(&vertices),
+            vertex_usage,
+        )?;
+        let indices = upload_buffer(
+            ctx,
+            &one_shot,
+            "scene indices",
+            bytemuck::cast_slice(&indices),
+            index_usage,
+        )?;
+        let gpu_materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .map(|m| GpuMaterial {
+                albedo: m.albedo.extend(m.dissolve).to_array(),
+                specular: m.specular.extend(m.roughness).to_array(),
+                emission: m.emission.extend(m.ior).to_array(),
+                albedo_texture: texture_index(m.albedo_texture),
+                coverage_texture: texture_index(m.coverage_texture),
+                normal_texture: texture_index(m.normal_texture),
+                pad: 0,
+            })
+            .collect();
+        let materials = upload_buffer(
+            ctx,
+            &one_shot,
+            "scene materials",
+            bytemuck::cast_slice(&gpu_materials),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+
+        let mut textures = Vec::new();
+        for texture in &scene.textures {
+            let format = match texture.kind {
+                TextureKind::Albedo => vk::Format::R8G8B8A8_SRGB,
+                TextureKind::Coverage | TextureKind::Normal => vk::Format::R8G8B8A8_UNORM,
+            };
+            let name = texture
+                .path
+                .file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+            textures.push(upload_texture(
+                ctx,
+                &one_shot,
+                &name,
+                format,
+                texture.width,
+                texture.height,
+                &texture.mips,
+            )?);
+        }
+        // Unused slots of the texture array must still hold a valid descriptor.
+        let white = upload_texture(
+            ctx,
+            &one_shot,
+            "white",
+            vk::Format::R8G8B8A8_UNORM,
+            1,
+            1,
+            &[vec![255; 4]],
+        )?;
+
+        let max_anisotropy = ctx.properties.limits.max_sampler_anisotropy.min(8.0);
+        let sampler = Sampler::new(
+            ctx,
+            "material sampler",
+            &vk::SamplerCreateInfo::default()
+                .mag_filter(vk::Filter::LINEAR)
+                .min_filter(vk::Filter::LINEAR)
+                .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
+                .address_mode_u(vk::SamplerAddressMode::REPEAT)
+                .address_mode_v(vk::SamplerAddressMode::REPEAT)
+                .address_mode_w(vk::SamplerAddressMode::REPEAT)
+                .anisotropy_enable(ctx.features.sampler_anisotropy)
+                .max_anisotropy(max_anisotropy)
+                .max_lod(vk::LOD_CLAMP_NONE),
+        )?;
+        let sets = DescriptorSets::new(ctx, "scene", &Self::bindings(), 1)?;
+        let set = sets.allocate("scene")?;
+        let image_infos: Vec<_> = (0..layout::MAX_TEXTURES as usize)
+            .map(|i| vk::DescriptorImageInfo {
+                sampler: vk::Sampler::null(),
+                image_view: textures.get(i).unwrap_or(&white).view,
+                image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            })
+            .collect();
+        SetWriter::new(ctx, set)
+            .buffer(
+                layout::BINDING_MATERIALS,
+                vk::DescriptorType::STORAGE_BUFFER,
+                materials.raw,
+            )
+            .images(
+                layout::BINDING_TEXTURES,
+                vk::DescriptorType::SAMPLED_IMAGE,
+                image_infos,
+            )
+            .sampler(layout::BINDING_MATERIAL_SAMPLER, sampler.raw)
+            .apply();
+        textures.push(white);
+        Ok(Self {
+            vertices,
+            indices,
+            materials,
+            draws,
+            set,
+            sets,
+            textures,
+            sampler,
+        })
+    }
+
+    /// Bytes of GPU memory held by textures.
+    pub fn texture_bytes(&self) -> u64 {
+        self.textures.iter().map(Image::memory_bytes).sum()
+    }
+
+    /// Binds the vertex and index buffers for mesh draws.
+    pub fn bind_geometry(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        unsafe {
+            ctx.device
+                .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.raw], &[0]);
+            ctx.device
+                .cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32);
+        }
+    }
+
+    pub fn sampler(&self) -> vk::Sampler {
+        self.sampler.raw
+    }
+}
+
+fn upload_texture(
+    ctx: &Arc<Context>,
+    one_shot: &OneShot,
+    name: &str,
+    format: vk::Format,
+    width: u32,
+    height: u32,
+    mips: &[Vec<u8>],
+) -> Result<Image> {
+    let mut desc = ImageDesc::d2(
+        format,
+        width,
+        height,
+        vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+    );
+    desc.mip_levels = mips.len() as u32;
+    let image = Image::new(ctx, name, desc)?;
+    let bytes: Vec<u8> = mips.concat();
+    let staging = Buffer::with_data(
+        ctx,
+        &format!("{name} staging"),
+        &bytes,
+        vk::BufferUsageFlags::TRANSFER_SRC,
+    )?;
+    let mut regions = Vec::new();
+    let mut offset = 0u64;
+    for (level, mip) in mips.iter().enumerate() {
+        regions.push(vk::BufferImageCopy {
+            buffer_offset: offset,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: level as u32,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D {
+                width: (width >> level).max(1),
+                height: (height >> level).max(1),
+                depth: 1,
+            },
+        });
+        offset += mip.len() as u64;
+    }
+    one_shot.run(&format!("upload {name}"), |cmd| {
+        image_barrier(
+            ctx,
+            cmd,
+            image.raw,
+            image.full_range(),
+            ImageUse::UNDEFINED,
+            ImageUse::TRANSFER_DST,
+        );
+        unsafe {
+            ctx.device.cmd_copy_buffer_to_image(
+                cmd,
+                staging.raw,
+                image.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &regions,
+            )
+        };
+        image_barrier(
+            ctx,
+            cmd,
+            image.raw,
+            image.full_range(),
+            ImageUse::TRANSFER_DST,
+            ImageUse::ANY_SHADER_READ,
+        );
+        Ok(())
+    })?;
+    Ok(image)
+}

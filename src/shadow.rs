@@ -1,0 +1,266 @@
+//! Shadow maps: one depth layer per light view (six cube faces for a point light, one
+//! for a spot or directional light), rendered every frame and sampled with PCF.
+
+use std::sync::Arc;
+
+use anyhow::Result;
+use ash::vk;
+use glam::{Mat4, Vec3};
+
+use crate::gpu_layout::{DrawPush, ShadowView};
+use crate::scene::{Aabb, Light, LightKind, Scene};
+use crate::scene_gpu::{GpuScene, VERTEX_ATTRIBUTES};
+use crate::vk::{
+    image_barrier, set_viewport, Context, GraphicsDesc, Image, ImageDesc, ImageUse, OwnedView,
+    Pipeline,
+};
+
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// Cube faces are rendered a little wider than 90 degrees so that PCF taps near a face
+/// edge still land inside the face.
+const CUBE_FACE_FOV_DEG: f32 = 95.0;
+
+pub struct ShadowPass {
+    pub map: Image,
+    layer_views: Vec<OwnedView>,
+    pipeline: Pipeline,
+    pub resolution: u32,
+}
+
+/// Number of shadow views a light needs.
+pub fn view_count(light: &Light) -> u32 {
+    match light.kind {
+        LightKind::Point => 6,
+        LightKind::Spot { .. } | LightKind::Directional { .. } => 1,
+    }
+}
+
+fn perspective(fov_deg: f32, near: f32, far: f32) -> Mat4 {
+    Mat4::perspective_rh(fov_deg.to_radians(), 1.0, near, far)
+}
+
+fn up_for(direction: Vec3) -> Vec3 {
+    if direction.normalize().y.abs() > 0.99 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    }
+}
+
+/// The views of `light` (already placed at time t) over a scene with world `bounds`.
+pub fn light_views(
+    light: &Light,
+    bounds: &Aabb,
+    resolution: u32,
+    first_layer: u32,
+) -> Vec<ShadowView> {
+    let radius = (bounds.max - bounds.min).length() * 0.5;
+    let center = (bounds.max + bounds.min) * 0.5;
+    let res = resolution as f32;
+    let perspective_view = |view: Mat4, fov_deg: f32, layer: u32| {
+        let far = (light.position - center).length() + radius;
+        let near = (far * 1e-4).max(1e-3);
+        ShadowView {
+            view_proj: (perspective(fov_deg, near, far) * view).to_cols_array_2d(),
+            origin: light.position.extend(0.0).to_array(),
+            texel_size: 2.0 * (fov_deg.to_radians() * 0.5).tan() / res,
+            layer,
+            near,
+            far,
+        }
+    };
+    match light.kind {
+        LightKind::Point => {
+            let faces = [
+                (Vec3::X, Vec3::NEG_Y),
+                (Vec3::NEG_X, Vec3::NEG_Y),
+                (Vec3::Y, Vec3::Z),
+                (Vec3::NEG_Y, Vec3::NEG_Z),
+                (Vec3::Z, Vec3::NEG_Y),
+                (Vec3::NEG_Z, Vec3::NEG_Y),
+            ];
+            faces
+                .iter()
+                .enumerate()
+                .map(|(i, &(dir, up))| {
+                    let view = Mat4::look_to_rh(light.position, dir, up);
+                    perspective_view(view, CUBE_FACE_FOV_DEG, first_layer + i as u32)
+                })
+                .collect()
+        }
+        LightKind::Spot {
+            direction,
+            outer_deg,
+            ..
+        } => {
+            let view = Mat4::look_to_rh(light.position, direction, up_for(direction));
+            let fov = (2.0 * outer_deg + 4.0).min(170.0);
+            vec![perspective_view(view, fov, first_layer)]
+        }
+        LightKind::Directional { direction } => {
+            let eye = center - direction * (radius * 2.0);
+            let view = Mat4::look_to_rh(eye, direction, up_for(direction));
+            let proj =
+                Mat4::orthographic_rh(-radius, radius, -radius, radius, radius, radius * 3.0);
+            vec![ShadowView {
+                view_proj: (proj * view).to_cols_array_2d(),
+                origin: direction.extend(1.0).to_array(),
+                texel_size: 2.0 * radius / res,
+                layer: first_layer,
+                near: radius,
+                far: radius * 3.0,
+            }]
+        }
+    }
+}
+
+/// All shadow views of the scene at time t, in light order.
+pub fn scene_views(scene: &Scene, time_s: f32, resolution: u32) -> Vec<ShadowView> {
+    let bounds = scene.bounds(time_s);
+    let mut views = Vec::new();
+    for i in 0..scene.lights.len() {
+        let light = scene.light_at(i, time_s);
+        let first = views.len() as u32;
+        views.extend(light_views(&light, &bounds, resolution, first));
+    }
+    views
+}
+
+impl ShadowPass {
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        resolution: u32,
+        set_layouts: &[vk::DescriptorSetLayout],
+    ) -> Result<Self> {
+        let layers: u32 = scene.lights.iter().map(view_count).sum::<u32>().max(1);
+        let mut desc = ImageDesc::d2(
+            DEPTH_FORMAT,
+            resolution,
+            resolution,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+        );
+        // At least two layers, so that the image's view is a 2D array (the shaders sample a
+        // sampler2DArrayShadow) even when one light has one view.
+        desc.layers = layers.max(2);
+        let map = Image::new(ctx, "shadow map", desc)?;
+        let layer_views = (0..layers)
+            .map(|l| map.layer_view(l, 0))
+            .collect::<Result<_>>()?;
+        let pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                name: "shadow",
+                vertex: crate::vk::shaders::SHADOW_SHADOW_VERT,
+                fragment: Some(crate::vk::shaders::SHADOW_SHADOW_FRAG),
+                vertex_stride: std::mem::size_of::<crate::scene::Vertex>() as u32,
+                // Position and uv (for cut-outs); the shadow pass has no use for normals.
+                attributes: &[VERTEX_ATTRIBUTES[0], VERTEX_ATTRIBUTES[2]],
+                set_layouts,
+                push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
+                color_formats: &[],
+                depth_format: Some(DEPTH_FORMAT),
+                cull: vk::CullModeFlags::NONE,
+                dynamic_depth_bias: true,
+                depth_clamp: ctx.features.depth_clamp,
+            },
+        )?;
+        Ok(Self {
+            map,
+            layer_views,
+            pipeline,
+            resolution,
+        })
+    }
+
+    /// The layout and stages the lighting pass leaves the map in.
+    pub const FINAL_USE: ImageUse = ImageUse::DEPTH_READ;
+
+    /// Renders every view; `sets` are the frame and scene descriptor sets.
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        scene: &Scene,
+        gpu: &GpuScene,
+        sets: &[(u32, vk::DescriptorSet)],
+        views: &[ShadowView],
+        time_s: f32,
+    ) {
+        image_barrier(
+            ctx,
+            cmd,
+            self.map.raw,
+            self.map.full_range(),
+            ImageUse::discard_after(Self::FINAL_USE),
+            ImageUse::DEPTH_ATTACHMENT,
+        );
+        let extent = vk::Extent2D {
+            width: self.resolution,
+            height: self.resolution,
+        };
+        let models: Vec<Mat4> = (0..scene.meshes.len())
+            .map(|m| scene.mesh_transform(m, time_s))
+            .collect();
+        for (index, view) in views.iter().enumerate() {
+            let depth = vk::RenderingAttachmentInfo::default()
+                .image_view(self.layer_views[view.layer as usize].raw)
+                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: 1.0,
+                        stencil: 0,
+                    },
+                });
+            let rendering = vk::RenderingInfo::default()
+                .render_area(vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent,
+                })
+                .layer_count(1)
+                .depth_attachment(&depth);
+            unsafe { ctx.device.cmd_begin_rendering(cmd, &rendering) };
+            set_viewport(ctx, cmd, extent);
+            // Slope-scaled bias removes acne on surfaces at grazing angles to the light;
+            // the lighting pass adds a normal offset for the rest.
+            unsafe { ctx.device.cmd_set_depth_bias(cmd, 0.0, 0.0, 1.5) };
+            self.pipeline.bind(cmd, sets);
+            gpu.bind_geometry(ctx, cmd);
+            for draw in &gpu.draws {
+                let push = DrawPush {
+                    model: models[draw.mesh].to_cols_array_2d(),
+                    material: draw.material,
+                    shadow_view: index as u32,
+                    ..Default::default()
+                };
+                self.pipeline.push(
+                    cmd,
+                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                    &push,
+                );
+                unsafe {
+                    ctx.device.cmd_draw_indexed(
+                        cmd,
+                        draw.index_count,
+                        1,
+                        draw.first_index,
+                        draw.vertex_offset,
+                        0,
+                    )
+                };
+            }
+            unsafe { ctx.device.cmd_end_rendering(cmd) };
+        }
+        image_barrier(
+            ctx,
+            cmd,
+            self.map.raw,
+            self.map.full_range(),
+            ImageUse::DEPTH_ATTACHMENT,
+            Self::FINAL_USE,
+        );
+    }
+}

@@ -1,0 +1,209 @@
+//! Barriers (synchronization2) and one-off command submission for uploads and read-backs.
+
+use std::sync::Arc;
+
+use anyhow::{Context as _, Result};
+use ash::vk;
+
+use super::Context;
+
+/// One side of an image barrier: a layout with the stages and accesses that use it.
+#[derive(Clone, Copy, Debug)]
+pub struct ImageUse {
+    pub layout: vk::ImageLayout,
+    pub stage: vk::PipelineStageFlags2,
+    pub access: vk::AccessFlags2,
+}
+
+impl ImageUse {
+    /// Contents are not needed (first use in a frame).
+    pub const UNDEFINED: Self = Self {
+        layout: vk::ImageLayout::UNDEFINED,
+        stage: vk::PipelineStageFlags2::TOP_OF_PIPE,
+        access: vk::AccessFlags2::NONE,
+    };
+    pub const COLOR_ATTACHMENT: Self = Self {
+        layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+        stage: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+        access: vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::COLOR_ATTACHMENT_WRITE.as_raw()
+                | vk::AccessFlags2::COLOR_ATTACHMENT_READ.as_raw(),
+        ),
+    };
+    pub const DEPTH_ATTACHMENT: Self = Self {
+        layout: vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+        stage: vk::PipelineStageFlags2::from_raw(
+            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw()
+                | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
+        ),
+        access: vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw()
+                | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ.as_raw(),
+        ),
+    };
+    pub const COMPUTE_READ: Self = Self {
+        layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+        access: vk::AccessFlags2::SHADER_READ,
+    };
+    pub const COMPUTE_STORAGE_READ: Self = Self {
+        layout: vk::ImageLayout::GENERAL,
+        stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+        access: vk::AccessFlags2::SHADER_STORAGE_READ,
+    };
+    pub const COMPUTE_WRITE: Self = Self {
+        layout: vk::ImageLayout::GENERAL,
+        stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+        access: vk::AccessFlags2::SHADER_STORAGE_WRITE,
+    };
+    pub const FRAGMENT_READ: Self = Self {
+        layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        stage: vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        access: vk::AccessFlags2::SHADER_SAMPLED_READ,
+    };
+    /// Sampled by any later shader (uploaded textures).
+    pub const ANY_SHADER_READ: Self = Self {
+        layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        stage: vk::PipelineStageFlags2::ALL_COMMANDS,
+        access: vk::AccessFlags2::SHADER_SAMPLED_READ,
+    };
+    pub const DEPTH_READ: Self = Self {
+        layout: vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
+        stage: vk::PipelineStageFlags2::from_raw(
+            vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw()
+                | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw(),
+        ),
+        access: vk::AccessFlags2::SHADER_SAMPLED_READ,
+    };
+    pub const TRANSFER_SRC: Self = Self {
+        layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+        stage: vk::PipelineStageFlags2::COPY,
+        access: vk::AccessFlags2::TRANSFER_READ,
+    };
+    pub const TRANSFER_DST: Self = Self {
+        layout: vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+        stage: vk::PipelineStageFlags2::from_raw(
+            vk::PipelineStageFlags2::COPY.as_raw() | vk::PipelineStageFlags2::BLIT.as_raw(),
+        ),
+        access: vk::AccessFlags2::TRANSFER_WRITE,
+    };
+    pub const PRESENT: Self = Self {
+        layout: vk::ImageLayout::PRESENT_SRC_KHR,
+        stage: vk::PipelineStageFlags2::NONE,
+        access: vk::AccessFlags2::NONE,
+    };
+}
+
+/// Records one image layout transition with its dependency.
+pub fn image_barrier(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    range: vk::ImageSubresourceRange,
+    from: ImageUse,
+    to: ImageUse,
+) {
+    let barrier = vk::ImageMemoryBarrier2::default()
+        .image(image)
+        .subresource_range(range)
+        .old_layout(from.layout)
+        .new_layout(to.layout)
+        .src_stage_mask(from.stage)
+        .src_access_mask(from.access)
+        .dst_stage_mask(to.stage)
+        .dst_access_mask(to.access);
+    let barriers = [barrier];
+    let dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
+}
+
+/// Records a global memory dependency (buffers, or images whose layout stays).
+pub fn memory_barrier(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+) {
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(src.0)
+        .src_access_mask(src.1)
+        .dst_stage_mask(dst.0)
+        .dst_access_mask(dst.1)];
+    let dependency = vk::DependencyInfo::default().memory_barriers(&barrier);
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
+}
+
+/// A command pool for work submitted once and waited for (uploads, read-backs).
+pub struct OneShot {
+    pool: vk::CommandPool,
+    ctx: Arc<Context>,
+}
+
+impl OneShot {
+    pub fn new(ctx: &Arc<Context>) -> Result<Self> {
+        let info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(ctx.queue_family)
+            .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+        let pool = unsafe { ctx.device.create_command_pool(&info, None) }?;
+        Ok(Self {
+            pool,
+            ctx: ctx.clone(),
+        })
+    }
+
+    /// Records with `record`, submits, and waits until the GPU is done.
+    pub fn run(
+        &self,
+        name: &str,
+        record: impl FnOnce(vk::CommandBuffer) -> Result<()>,
+    ) -> Result<()> {
+        let ctx = &self.ctx;
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(self.pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        let cmd = unsafe { ctx.device.allocate_command_buffers(&info) }?[0];
+        let result = (|| {
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            unsafe { ctx.device.begin_command_buffer(cmd, &begin) }?;
+            ctx.begin_label(cmd, name);
+            record(cmd)?;
+            ctx.end_label(cmd);
+            unsafe { ctx.device.end_command_buffer(cmd) }?;
+            let fence = unsafe {
+                ctx.device
+                    .create_fence(&vk::FenceCreateInfo::default(), None)
+            }?;
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+            let waited = unsafe {
+                ctx.device
+                    .queue_submit2(ctx.queue, &submit, fence)
+                    .and_then(|_| ctx.device.wait_for_fences(&[fence], true, u64::MAX))
+            };
+            unsafe { ctx.device.destroy_fence(fence, None) };
+            waited.with_context(|| format!("GPU work '{name}' failed"))
+        })();
+        unsafe { ctx.device.free_command_buffers(self.pool, &[cmd]) };
+        result
+    }
+}
+
+impl Drop for OneShot {
+    fn drop(&mut self) {
+        unsafe { self.ctx.device.destroy_command_pool(self.pool, None) };
+    }
+}
+
+impl ImageUse {
+    /// Contents not needed, after a use in `stage` (the previous frame's last use) that the
+    /// layout transition must wait for.
+    pub fn discard_after(previous: ImageUse) -> Self {
+        Self {
+            layout: vk::ImageLayout::UNDEFINED,
+            stage: previous.stage,
+            access: vk::AccessFlags2::NONE,
+        }
+    }
+}

@@ -1,0 +1,25 @@
+//! A thin layer over `ash`: device, memory, descriptors, pipelines, timeline sync,
+//! timestamps and debug labels.
+
+mod commands;
+mod context;
+mod descriptors;
+mod memory;
+mod pipeline;
+mod swapchain;
+mod sync;
+mod timestamps;
+
+pub use commands::{image_barrier, memory_barrier, ImageUse, OneShot};
+pub use context::{Context, ContextOptions, Features};
+pub use descriptors::{Binding, DescriptorSets, SetWriter};
+pub use memory::{is_depth_format, upload_buffer, Buffer, Image, ImageDesc, OwnedView, Sampler};
+pub use pipeline::{groups, set_viewport, GraphicsDesc, Pipeline};
+pub use swapchain::{Acquired, Swapchain};
+pub use sync::{Frame, FrameRing};
+pub use timestamps::GpuTimer;
+
+/// SPIR-V of every shader under `glsl/`, named after its path.
+pub mod shaders {
+    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+}
