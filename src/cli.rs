@@ -99,6 +99,10 @@ pub struct ViewArgs {
     /// Save a PNG screenshot of the last frame here on exit.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
+    /// Ask the window system to resize the window to WIDTHxHEIGHT halfway through
+    /// `--frames` (smoke tests of swapchain recreation).
+    #[arg(long, value_parser = parse_size, requires = "frames")]
+    pub resize_to: Option<(u32, u32)>,
 }
 
 #[derive(Args, Debug)]

@@ -4,11 +4,9 @@ use std::sync::Arc;
 
 use anyhow::Result;
 use ash::vk;
-use glam::Mat4;
 
 use crate::gpu_layout::DrawPush;
-use crate::scene::Scene;
-use crate::scene_gpu::{GpuScene, VERTEX_ATTRIBUTES};
+use crate::scene_gpu::{SceneDraw, VERTEX_ATTRIBUTES};
 use crate::vk::{
     image_barrier, set_viewport, Context, GraphicsDesc, Image, ImageDesc, ImageUse, Pipeline,
 };
@@ -94,16 +92,12 @@ impl GBufferPass {
         Ok(Self { pipeline })
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         target: &GBuffer,
-        scene: &Scene,
-        gpu: &GpuScene,
-        sets: &[(u32, vk::DescriptorSet)],
-        time_s: f32,
+        draw: &SceneDraw,
     ) {
         for image in target.colors() {
             image_barrier(
@@ -159,31 +153,7 @@ impl GBufferPass {
             .depth_attachment(&depth);
         unsafe { ctx.device.cmd_begin_rendering(cmd, &rendering) };
         set_viewport(ctx, cmd, extent);
-        self.pipeline.bind(cmd, sets);
-        gpu.bind_geometry(ctx, cmd);
-        for draw in &gpu.draws {
-            let model: Mat4 = scene.mesh_transform(draw.mesh, time_s);
-            let push = DrawPush {
-                model: model.to_cols_array_2d(),
-                material: draw.material,
-                ..Default::default()
-            };
-            self.pipeline.push(
-                cmd,
-                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                &push,
-            );
-            unsafe {
-                ctx.device.cmd_draw_indexed(
-                    cmd,
-                    draw.index_count,
-                    1,
-                    draw.first_index,
-                    draw.vertex_offset,
-                    0,
-                )
-            };
-        }
+        draw.draw_meshes(ctx, cmd, &self.pipeline, 0);
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         for image in target.colors() {
             image_barrier(

@@ -5,67 +5,108 @@ use std::path::Path;
 use anyhow::{bail, Context as _, Result};
 
 /// An RGB float image, row 0 at the top.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RgbImage {
     pub width: u32,
     pub height: u32,
-    /// Three floats per pixel.
+    /// Three floats per pixel, rows top to bottom.
     pub data: Vec<f32>,
 }
 
-fn extension(path: &Path) -> String {
-    path.extension()
+const SUPPORTED: &str = "supported: .exr (linear), .png or .jpg (sRGB)";
+
+/// Whether a path's extension names linear radiance (EXR) or sRGB-encoded values.
+fn is_hdr_path(path: &Path) -> Result<bool> {
+    let ext = path
+        .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
-        .unwrap_or_default()
+        .unwrap_or_default();
+    match ext.as_str() {
+        "exr" => Ok(true),
+        "png" | "jpg" | "jpeg" => Ok(false),
+        _ => bail!(
+            "{}: unknown image extension {ext:?} ({SUPPORTED})",
+            path.display()
+        ),
+    }
 }
 
-/// Writes raw linear radiance (no exposure, no tonemap) as RGB float32 OpenEXR.
-pub fn write_exr(path: &Path, width: u32, height: u32, rgba_linear: &[f32]) -> Result<()> {
-    let rgb: Vec<f32> = rgba_linear
-        .chunks_exact(4)
+/// Keeps the first three of every `channels` values, checking that `data` holds exactly
+/// `width * height` pixels first: the encoders below would otherwise panic or write garbage.
+fn rgb_of<T: Copy>(path: &Path, width: u32, height: u32, data: &[T], channels: usize) -> Result<Vec<T>> {
+    let pixels = usize::try_from(u64::from(width) * u64::from(height))
+        .with_context(|| format!("{}: {width}x{height} is too large", path.display()))?;
+    if Some(data.len()) != pixels.checked_mul(channels) {
+        bail!(
+            "{}: {width}x{height} needs {pixels} pixels of {channels} channels, got {} values",
+            path.display(),
+            data.len()
+        );
+    }
+    Ok(data
+        .chunks_exact(channels)
         .flat_map(|p| [p[0], p[1], p[2]])
-        .collect();
+        .collect())
+}
+
+/// Writes raw linear radiance (no exposure, no tonemap) as RGB float32 OpenEXR; alpha is
+/// dropped.
+pub fn write_exr(path: &Path, width: u32, height: u32, rgba_linear: &[f32]) -> Result<()> {
+    let rgb = rgb_of(path, width, height, rgba_linear, 4)?;
     let image = image::Rgb32FImage::from_raw(width, height, rgb)
-        .context("image size does not match its data")?;
+        .with_context(|| format!("{}: image size does not match its data", path.display()))?;
     image
         .save_with_format(path, image::ImageFormat::OpenExr)
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Writes sRGB-encoded RGBA bytes as an RGB PNG.
+/// Writes already tonemapped sRGB RGBA bytes as an RGB PNG; alpha is dropped.
 pub fn write_png(path: &Path, width: u32, height: u32, rgba8_srgb: &[u8]) -> Result<()> {
-    let rgb: Vec<u8> = rgba8_srgb
-        .chunks_exact(4)
-        .flat_map(|p| [p[0], p[1], p[2]])
-        .collect();
-    let image = image::RgbImage::from_raw(width, height, rgb)
-        .context("image size does not match its data")?;
+    let rgb = rgb_of(path, width, height, rgba8_srgb, 4)?;
+    write_png_rgb(path, width, height, rgb)
+}
+
+/// Writes RGB bytes as a PNG.
+pub(crate) fn write_png_rgb(path: &Path, width: u32, height: u32, rgb8: Vec<u8>) -> Result<()> {
+    let image = image::RgbImage::from_raw(width, height, rgb8)
+        .with_context(|| format!("{}: image size does not match its data", path.display()))?;
     image
         .save_with_format(path, image::ImageFormat::Png)
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Loads an image: `.exr` as linear floats (`true`), `.png`/`.jpg` as sRGB-encoded values
-/// in [0, 1] (`false`).
+/// Loads an image as RGB floats. `.exr` gives linear radiance (first three channels) and
+/// `true`; `.png`/`.jpg` give the stored sRGB-encoded values scaled to [0, 1], not decoded,
+/// and `false`, as `compare.py` reads them.
 pub fn load_rgb(path: &Path) -> Result<(RgbImage, bool)> {
-    let hdr = match extension(path).as_str() {
-        "exr" => true,
-        "png" | "jpg" | "jpeg" => false,
-        other => bail!(
-            "{}: unsupported image type {other:?} (supported: .exr, .png, .jpg)",
-            path.display()
-        ),
-    };
-    let image = image::open(path).with_context(|| format!("reading {}", path.display()))?;
-    let rgb = image.to_rgb32f();
+    let is_hdr = is_hdr_path(path)?;
+    let reader = image::ImageReader::open(path)
+        .with_context(|| format!("opening {}", path.display()))?;
+    let image = reader
+        .with_guessed_format()
+        .with_context(|| format!("reading {}", path.display()))?;
+    // The contents pick the decoder (as PIL does for compare.py), but the extension is
+    // what says whether the values are linear, so the two must agree on that.
+    let exr_contents = image.format() == Some(image::ImageFormat::OpenExr);
+    if exr_contents != is_hdr {
+        bail!(
+            "{}: contents are {:?}, which its extension does not name",
+            path.display(),
+            image.format()
+        );
+    }
+    let rgb = image
+        .decode()
+        .with_context(|| format!("decoding {}", path.display()))?
+        .into_rgb32f();
     Ok((
         RgbImage {
             width: rgb.width(),
             height: rgb.height(),
             data: rgb.into_raw(),
         },
-        hdr,
+        is_hdr,
     ))
 }
 
@@ -83,33 +124,78 @@ pub fn srgb_encode(x: f32) -> f32 {
 mod tests {
     use super::*;
 
+    fn temp_path(name: &str) -> std::path::PathBuf {
+        std::env::temp_dir().join(format!("voxcone-imageio-{}-{name}", std::process::id()))
+    }
+
     #[test]
     fn srgb_encode_known_values() {
         assert_eq!(srgb_encode(0.0), 0.0);
-        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
-        assert!((srgb_encode(0.5) - 0.735_356_7).abs() < 1e-5);
-        assert_eq!(srgb_encode(7.0), srgb_encode(1.0));
         assert_eq!(srgb_encode(-1.0), 0.0);
+        assert!((srgb_encode(0.001) - 0.012_92).abs() < 1e-7);
+        assert!((srgb_encode(0.003_130_8) - 0.040_449_936).abs() < 1e-6);
+        assert!((srgb_encode(0.18) - 0.461_356_1).abs() < 1e-5);
+        assert!((srgb_encode(0.5) - 0.735_356_7).abs() < 1e-5);
+        assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
+        assert_eq!(srgb_encode(7.0), srgb_encode(1.0));
     }
 
     #[test]
-    fn exr_round_trip_is_exact() {
-        let path = std::env::temp_dir().join(format!("voxcone-exr-{}.exr", std::process::id()));
-        let rgba: Vec<f32> = (0..2 * 3 * 4).map(|i| i as f32 * 0.37 + 1e-3).collect();
-        write_exr(&path, 2, 3, &rgba).unwrap();
-        let (image, hdr) = load_rgb(&path).unwrap();
+    fn exr_round_trip_is_bit_exact() {
+        let path = temp_path("round-trip.exr");
+        let (width, height) = (5, 3);
+        // Denormal, half-float overflow and huge values must all survive as float32.
+        let mut rgba: Vec<f32> = (0..width * height * 4)
+            .map(|i| (i as f32 * 0.37 + 1e-3).powf(1.7) - 2.0)
+            .collect();
+        rgba[..3].copy_from_slice(&[f32::MIN_POSITIVE / 4.0, 6.5e4, 1.0e30]);
+        write_exr(&path, width, height, &rgba).unwrap();
+        let loaded = load_rgb(&path);
         std::fs::remove_file(&path).ok();
-        assert!(hdr);
-        let expected: Vec<f32> = rgba
+        let (image, is_hdr) = loaded.unwrap();
+        assert!(is_hdr);
+        assert_eq!((image.width, image.height), (width, height));
+        let expected: Vec<u32> = rgba
             .chunks_exact(4)
             .flat_map(|p| [p[0], p[1], p[2]])
+            .map(f32::to_bits)
             .collect();
-        assert_eq!(image.data, expected);
+        let got: Vec<u32> = image.data.iter().map(|v| v.to_bits()).collect();
+        assert_eq!(got, expected);
     }
 
     #[test]
-    fn unknown_extension_is_explained() {
-        let err = load_rgb(Path::new("x.bmpx")).unwrap_err();
-        assert!(format!("{err:#}").contains("supported"));
+    fn png_loads_as_stored_srgb_values() {
+        let path = temp_path("bytes.png");
+        let rgba = [0, 128, 255, 7, 10, 20, 30, 0];
+        write_png(&path, 2, 1, &rgba).unwrap();
+        let loaded = load_rgb(&path);
+        std::fs::remove_file(&path).ok();
+        let (image, is_hdr) = loaded.unwrap();
+        assert!(!is_hdr);
+        let bytes: Vec<u8> = image.data.iter().map(|v| (v * 255.0).round() as u8).collect();
+        assert_eq!(bytes, [0, 128, 255, 10, 20, 30]);
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        let err = load_rgb(Path::new("picture.bmpx")).unwrap_err();
+        let text = format!("{err:#}");
+        assert!(text.contains("picture.bmpx") && text.contains(".exr") && text.contains(".png"));
+
+        let missing = temp_path("missing.exr");
+        assert!(format!("{:#}", load_rgb(&missing).unwrap_err()).contains("missing.exr"));
+
+        let not_png = temp_path("not-really.png");
+        std::fs::write(&not_png, b"plain text").unwrap();
+        let err = load_rgb(&not_png);
+        std::fs::remove_file(&not_png).ok();
+        assert!(format!("{:#}", err.unwrap_err()).contains("not-really.png"));
+
+        let short = temp_path("short.exr");
+        let err = write_exr(&short, 4, 4, &[0.0; 12]).unwrap_err();
+        assert!(format!("{err:#}").contains("short.exr"));
+        assert!(!short.exists());
+        assert!(write_png(&temp_path("huge.png"), u32::MAX, u32::MAX, &[]).is_err());
     }
 }

@@ -14,7 +14,7 @@ use crate::gbuffer::{GBuffer, GBufferPass};
 use crate::gpu_layout::{self as layout, FrameUniforms, GpuLight, ShadowView};
 use crate::lighting::LightingPass;
 use crate::scene::{Camera, LightKind, Scene};
-use crate::scene_gpu::GpuScene;
+use crate::scene_gpu::{GpuScene, SceneDraw};
 use crate::shadow::{self, ShadowPass};
 use crate::vk::{
     image_barrier, memory_barrier, Binding, Buffer, Context, DescriptorSets, Frame, FrameRing,
@@ -289,7 +289,10 @@ impl Renderer {
 
     /// Recreates the screen-sized images; waits for frames in flight first.
     pub fn resize(&mut self, extent: vk::Extent2D) -> Result<()> {
-        self.ring.wait_all()?;
+        // New images may take the memory of old ones; a device-wide wait orders every
+        // earlier access before them (synchronization validation tracks this wait, not a
+        // host wait on the timeline).
+        self.ctx.wait_idle()?;
         self.targets = Self::create_targets(&self.ctx, extent)?;
         self.radiance_last_use = ImageUse::FRAGMENT_READ;
         self.bind_targets();
@@ -393,28 +396,25 @@ impl Renderer {
         data.lights.write(0, bytemuck::cast_slice(&lights));
         data.shadow_views.write(0, bytemuck::cast_slice(&views));
         let data = &mut self.frames[frame.slot];
-        let sets = [
-            (layout::SET_FRAME, data.set),
-            (layout::SET_SCENE, self.gpu.set),
-        ];
+        let draw = SceneDraw {
+            scene: &self.scene,
+            gpu: &self.gpu,
+            sets: [
+                (layout::SET_FRAME, data.set),
+                (layout::SET_SCENE, self.gpu.set),
+            ],
+            time_s,
+        };
         let timer = &mut data.timer;
         timer.reset(cmd);
 
         timer.begin(cmd, "shadow");
-        self.shadow
-            .record(&ctx, cmd, &self.scene, &self.gpu, &sets, &views, time_s);
+        self.shadow.record(&ctx, cmd, &draw, &views);
         timer.end(cmd);
 
         timer.begin(cmd, "gbuffer");
-        self.gbuffer_pass.record(
-            &ctx,
-            cmd,
-            &self.targets.gbuffer,
-            &self.scene,
-            &self.gpu,
-            &sets,
-            time_s,
-        );
+        self.gbuffer_pass
+            .record(&ctx, cmd, &self.targets.gbuffer, &draw);
         timer.end(cmd);
 
         timer.begin(cmd, "lighting");

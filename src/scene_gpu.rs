@@ -6,12 +6,62 @@ use std::sync::Arc;
 use anyhow::{bail, Result};
 use ash::vk;
 
-use crate::gpu_layout::{self as layout, GpuMaterial};
+use crate::gpu_layout::{self as layout, DrawPush, GpuMaterial};
 use crate::scene::{Scene, TextureKind, Vertex};
 use crate::vk::{
     image_barrier, upload_buffer, Binding, Buffer, Context, DescriptorSets, Image, ImageDesc,
-    ImageUse, OneShot, Sampler, SetWriter,
+    ImageUse, OneShot, Pipeline, Sampler, SetWriter,
 };
+
+/// What mesh draws need: the scene at a time and the descriptor sets to bind.
+pub struct SceneDraw<'a> {
+    pub scene: &'a crate::scene::Scene,
+    pub gpu: &'a GpuScene,
+    /// The frame and scene descriptor sets.
+    pub sets: [(u32, vk::DescriptorSet); 2],
+    pub time_s: f32,
+}
+
+impl SceneDraw<'_> {
+    /// Binds `pipeline` and the geometry, then draws every mesh with its model matrix
+    /// and material in the push constants; `shadow_view` selects the shadow view.
+    pub fn draw_meshes(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        pipeline: &Pipeline,
+        shadow_view: u32,
+    ) {
+        pipeline.bind(cmd, &self.sets);
+        self.gpu.bind_geometry(ctx, cmd);
+        for draw in &self.gpu.draws {
+            let push = DrawPush {
+                model: self
+                    .scene
+                    .mesh_transform(draw.mesh, self.time_s)
+                    .to_cols_array_2d(),
+                material: draw.material,
+                shadow_view,
+                ..Default::default()
+            };
+            pipeline.push(
+                cmd,
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                &push,
+            );
+            unsafe {
+                ctx.device.cmd_draw_indexed(
+                    cmd,
+                    draw.index_count,
+                    1,
+                    draw.first_index,
+                    draw.vertex_offset,
+                    0,
+                )
+            };
+        }
+    }
+}
 
 /// One indexed draw: a mesh of the scene.
 #[derive(Clone, Copy, Debug)]

@@ -9,7 +9,7 @@ use glam::{Mat4, Vec3};
 
 use crate::gpu_layout::{DrawPush, ShadowView};
 use crate::scene::{Aabb, Light, LightKind, Scene};
-use crate::scene_gpu::{GpuScene, VERTEX_ATTRIBUTES};
+use crate::scene_gpu::{SceneDraw, VERTEX_ATTRIBUTES};
 use crate::vk::{
     image_barrier, set_viewport, Context, GraphicsDesc, Image, ImageDesc, ImageUse, OwnedView,
     Pipeline,
@@ -177,16 +177,13 @@ impl ShadowPass {
     /// The layout and stages the lighting pass leaves the map in.
     pub const FINAL_USE: ImageUse = ImageUse::DEPTH_READ;
 
-    /// Renders every view; `sets` are the frame and scene descriptor sets.
+    /// Renders every view.
     pub fn record(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
-        scene: &Scene,
-        gpu: &GpuScene,
-        sets: &[(u32, vk::DescriptorSet)],
+        draw: &SceneDraw,
         views: &[ShadowView],
-        time_s: f32,
     ) {
         image_barrier(
             ctx,
@@ -200,9 +197,6 @@ impl ShadowPass {
             width: self.resolution,
             height: self.resolution,
         };
-        let models: Vec<Mat4> = (0..scene.meshes.len())
-            .map(|m| scene.mesh_transform(m, time_s))
-            .collect();
         for (index, view) in views.iter().enumerate() {
             let depth = vk::RenderingAttachmentInfo::default()
                 .image_view(self.layer_views[view.layer as usize].raw)
@@ -227,31 +221,7 @@ impl ShadowPass {
             // Slope-scaled bias removes acne on surfaces at grazing angles to the light;
             // the lighting pass adds a normal offset for the rest.
             unsafe { ctx.device.cmd_set_depth_bias(cmd, 0.0, 0.0, 1.5) };
-            self.pipeline.bind(cmd, sets);
-            gpu.bind_geometry(ctx, cmd);
-            for draw in &gpu.draws {
-                let push = DrawPush {
-                    model: models[draw.mesh].to_cols_array_2d(),
-                    material: draw.material,
-                    shadow_view: index as u32,
-                    ..Default::default()
-                };
-                self.pipeline.push(
-                    cmd,
-                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                    &push,
-                );
-                unsafe {
-                    ctx.device.cmd_draw_indexed(
-                        cmd,
-                        draw.index_count,
-                        1,
-                        draw.first_index,
-                        draw.vertex_offset,
-                        0,
-                    )
-                };
-            }
+            draw.draw_meshes(ctx, cmd, &self.pipeline, index as u32);
             unsafe { ctx.device.cmd_end_rendering(cmd) };
         }
         image_barrier(

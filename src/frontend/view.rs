@@ -342,6 +342,15 @@ impl App {
             return;
         }
         self.frames += 1;
+        if let (Some((w, h)), Some(n)) = (self.args.resize_to, self.args.frames) {
+            if self.frames == n / 2 {
+                log::info!("resizing the window to {w}x{h}");
+                // The new size arrives as a Resized event, or is applied at once.
+                let _ = viewer
+                    .window
+                    .request_inner_size(winit::dpi::PhysicalSize::new(w, h));
+            }
+        }
         if now.duration_since(self.last_title).as_secs_f32() > 0.5 {
             self.last_title = now;
             let passes: Vec<String> = viewer

@@ -246,7 +246,7 @@ fn animation_from_spec(i: usize, spec: &Option<AnimationSpec>) -> Result<Option<
             amplitude,
             period_s,
         }) => {
-            if !(*period_s > 0.0) {
+            if period_s.is_nan() || *period_s <= 0.0 {
                 bail!("mesh[{i}].animate.period_s must be positive");
             }
             Some(Animation::Oscillate {

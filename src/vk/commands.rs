@@ -87,9 +87,11 @@ impl ImageUse {
         ),
         access: vk::AccessFlags2::TRANSFER_WRITE,
     };
+    /// The layout transition must be in a stage the frame's semaphore signal (stage
+    /// ALL_COMMANDS) waits for, or present reads before it (SYNC-HAZARD-PRESENT-AFTER-WRITE).
     pub const PRESENT: Self = Self {
         layout: vk::ImageLayout::PRESENT_SRC_KHR,
-        stage: vk::PipelineStageFlags2::NONE,
+        stage: vk::PipelineStageFlags2::ALL_COMMANDS,
         access: vk::AccessFlags2::NONE,
     };
 }
