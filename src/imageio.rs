@@ -34,7 +34,13 @@ fn is_hdr_path(path: &Path) -> Result<bool> {
 
 /// Keeps the first three of every `channels` values, checking that `data` holds exactly
 /// `width * height` pixels first: the encoders below would otherwise panic or write garbage.
-fn rgb_of<T: Copy>(path: &Path, width: u32, height: u32, data: &[T], channels: usize) -> Result<Vec<T>> {
+fn rgb_of<T: Copy>(
+    path: &Path,
+    width: u32,
+    height: u32,
+    data: &[T],
+    channels: usize,
+) -> Result<Vec<T>> {
     let pixels = usize::try_from(u64::from(width) * u64::from(height))
         .with_context(|| format!("{}: {width}x{height} is too large", path.display()))?;
     if Some(data.len()) != pixels.checked_mul(channels) {
@@ -81,8 +87,8 @@ pub(crate) fn write_png_rgb(path: &Path, width: u32, height: u32, rgb8: Vec<u8>)
 /// and `false`, as `compare.py` reads them.
 pub fn load_rgb(path: &Path) -> Result<(RgbImage, bool)> {
     let is_hdr = is_hdr_path(path)?;
-    let reader = image::ImageReader::open(path)
-        .with_context(|| format!("opening {}", path.display()))?;
+    let reader =
+        image::ImageReader::open(path).with_context(|| format!("opening {}", path.display()))?;
     let image = reader
         .with_guessed_format()
         .with_context(|| format!("reading {}", path.display()))?;
@@ -173,7 +179,11 @@ mod tests {
         std::fs::remove_file(&path).ok();
         let (image, is_hdr) = loaded.unwrap();
         assert!(!is_hdr);
-        let bytes: Vec<u8> = image.data.iter().map(|v| (v * 255.0).round() as u8).collect();
+        let bytes: Vec<u8> = image
+            .data
+            .iter()
+            .map(|v| (v * 255.0).round() as u8)
+            .collect();
         assert_eq!(bytes, [0, 128, 255, 10, 20, 30]);
     }
 
