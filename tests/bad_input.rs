@@ -123,3 +123,20 @@ fn bad_output_extension() {
 fn no_such_device() {
     assert_fails_naming(&["render", "--device", "no-such-gpu"], &["no-such-gpu"]);
 }
+
+#[test]
+fn no_vulkan_driver() {
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_voxcone"))
+        .args(["render", "-o", "never.png"])
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    let err = stderr(&output);
+    assert!(!output.status.success());
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        err.contains("mesa-vulkan-drivers"),
+        "no install hint: {err}"
+    );
+}

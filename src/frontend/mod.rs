@@ -6,7 +6,6 @@ pub mod view;
 
 use std::ffi::CStr;
 use std::sync::Arc;
-use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 use ash::vk;
@@ -31,20 +30,8 @@ pub fn create_context(
 
 pub fn load_scene(common: &CommonArgs) -> Result<Scene> {
     let path = common.scene_path();
-    let start = Instant::now();
-    let scene = Scene::load(&path, &common.load_options())
-        .with_context(|| format!("loading scene {}", path.display()))?;
-    log::info!(
-        "scene {}: {} triangles, {} meshes, {} materials, {} textures, {} lights, loaded in {:.2} s",
-        path.display(),
-        scene.triangle_count,
-        scene.meshes.len(),
-        scene.materials.len(),
-        scene.textures.len(),
-        scene.lights.len(),
-        start.elapsed().as_secs_f64()
-    );
-    Ok(scene)
+    Scene::load(&path, &common.load_options())
+        .with_context(|| format!("loading scene {}", path.display()))
 }
 
 /// Fails if the validation layer reported anything.

@@ -1,5 +1,7 @@
 //! Simple scene animation: spinning or oscillating meshes, orbiting lights.
 
+use std::f32::consts::TAU;
+
 use glam::{Mat4, Quat, Vec3};
 
 use super::Aabb;
@@ -7,7 +9,7 @@ use super::Aabb;
 /// Motion of a mesh, applied in object space before its scene-file transform.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Animation {
-    /// Rotation about the mesh's bounds centre.
+    /// Rotation about `axis` through the centre of the object's bounds.
     Spin { axis: Vec3, deg_per_s: f32 },
     /// Translation `amplitude * sin(2 pi t / period_s)` along `axis`.
     Oscillate {
@@ -18,6 +20,7 @@ pub enum Animation {
 }
 
 impl Animation {
+    /// Object-space motion at time `t` of an object whose bounds are `local_bounds`.
     pub fn matrix(&self, local_bounds: &Aabb, t: f32) -> Mat4 {
         match *self {
             Animation::Spin { axis, deg_per_s } => {
@@ -30,15 +33,13 @@ impl Animation {
                 axis,
                 amplitude,
                 period_s,
-            } => {
-                let phase = std::f32::consts::TAU * t / period_s;
-                Mat4::from_translation(axis.normalize() * amplitude * phase.sin())
-            }
+            } => Mat4::from_translation(axis.normalize() * amplitude * (TAU * t / period_s).sin()),
         }
     }
 }
 
-/// A light position rotating about `center` around `axis`, once per `period_s`.
+/// A light position rotating about `center` around `axis` (right-handed), once per
+/// `period_s`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Orbit {
     pub center: Vec3,
@@ -48,8 +49,8 @@ pub struct Orbit {
 
 impl Orbit {
     pub fn apply(&self, position: Vec3, t: f32) -> Vec3 {
-        let angle = std::f32::consts::TAU * t / self.period_s;
-        self.center + Quat::from_axis_angle(self.axis.normalize(), angle) * (position - self.center)
+        let rotation = Quat::from_axis_angle(self.axis.normalize(), TAU * t / self.period_s);
+        self.center + rotation * (position - self.center)
     }
 }
 
@@ -57,30 +58,54 @@ impl Orbit {
 mod tests {
     use super::*;
 
+    const BOUNDS: Aabb = Aabb {
+        min: Vec3::new(1.0, 2.0, 3.0),
+        max: Vec3::new(2.0, 4.0, 5.0),
+    };
+
     #[test]
-    fn full_spin_and_zero_time_are_identity() {
-        let bounds = Aabb {
-            min: Vec3::new(1.0, 2.0, 3.0),
-            max: Vec3::new(2.0, 4.0, 5.0),
-        };
+    fn spin_turns_about_the_bounds_centre() {
         let spin = Animation::Spin {
-            axis: Vec3::Y,
+            axis: Vec3::new(0.0, 2.0, 0.0),
             deg_per_s: 90.0,
         };
-        assert!(spin.matrix(&bounds, 4.0).abs_diff_eq(Mat4::IDENTITY, 1e-5));
+        assert!(
+            spin.matrix(&BOUNDS, 4.0).abs_diff_eq(Mat4::IDENTITY, 1e-5),
+            "360 degrees"
+        );
+        let quarter = spin.matrix(&BOUNDS, 1.0);
+        let c = BOUNDS.center();
+        assert!(quarter.transform_point3(c).abs_diff_eq(c, 1e-5));
+        // A quarter turn about +Y takes +X to -Z.
+        let p = quarter.transform_point3(c + Vec3::X);
+        assert!(p.abs_diff_eq(c - Vec3::Z, 1e-5), "{p}");
+    }
+
+    #[test]
+    fn oscillate_starts_at_rest_position() {
         let wobble = Animation::Oscillate {
             axis: Vec3::X,
             amplitude: 0.5,
             period_s: 2.0,
         };
         assert!(wobble
-            .matrix(&bounds, 0.0)
+            .matrix(&BOUNDS, 0.0)
             .abs_diff_eq(Mat4::IDENTITY, 1e-6));
+        let peak = wobble.matrix(&BOUNDS, 0.5).transform_point3(Vec3::ZERO);
+        assert!(peak.abs_diff_eq(Vec3::new(0.5, 0.0, 0.0), 1e-6), "{peak}");
+    }
+
+    #[test]
+    fn orbit_turns_once_per_period() {
         let orbit = Orbit {
-            center: Vec3::ZERO,
+            center: Vec3::new(0.0, 1.0, 0.0),
             axis: Vec3::Y,
             period_s: 4.0,
         };
-        assert!(orbit.apply(Vec3::X, 1.0).abs_diff_eq(Vec3::NEG_Z, 1e-5));
+        let start = Vec3::new(1.0, 1.0, 0.0);
+        assert!(orbit
+            .apply(start, 1.0)
+            .abs_diff_eq(Vec3::new(0.0, 1.0, -1.0), 1e-5));
+        assert!(orbit.apply(start, 4.0).abs_diff_eq(start, 1e-5));
     }
 }

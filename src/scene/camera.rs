@@ -16,11 +16,24 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// A camera with placeholder clip planes, to be set by [`Camera::fit_clip_planes`].
+    pub fn look_at(position: Vec3, target: Vec3, up: Vec3, fov_y_deg: f32) -> Self {
+        Self {
+            position,
+            target,
+            up,
+            fov_y_deg,
+            near: 0.01,
+            far: 100.0,
+        }
+    }
+
     pub fn view(&self) -> Mat4 {
         Mat4::look_at_rh(self.position, self.target, self.up)
     }
 
-    /// View to Vulkan clip space: depth 0..1, and y flipped so that image row 0 is the top.
+    /// View to Vulkan clip space: depth 0..1, and y flipped so that image row 0 is the top
+    /// (Vulkan's NDC y points down the framebuffer).
     pub fn proj(&self, aspect: f32) -> Mat4 {
         let mut p = Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, self.near, self.far);
         p.y_axis.y = -p.y_axis.y;
@@ -31,13 +44,15 @@ impl Camera {
         (self.target - self.position).normalize()
     }
 
+    /// The image's +x axis, as in the references' convention cross(forward, up).
     pub fn right(&self) -> Vec3 {
         self.forward().cross(self.up).normalize()
     }
 
-    /// Near and far planes that hold `bounds` seen from the camera.
+    /// Clip planes for a scene with world `bounds`: near scales with the scene so depth
+    /// precision follows it; far leaves room to back away from the scene.
     pub fn fit_clip_planes(&mut self, bounds: &Aabb) {
-        let diagonal = bounds.size().length().max(1e-3);
+        let diagonal = bounds.diagonal().max(1e-3);
         self.near = (diagonal * 1e-3).max(1e-4);
         self.far = 4.0 * ((bounds.center() - self.position).length() + diagonal);
     }
@@ -47,22 +62,52 @@ impl Camera {
 mod tests {
     use super::*;
 
+    fn cornell_camera() -> Camera {
+        Camera::look_at(
+            Vec3::new(0.0, 1.0, 3.9),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::Y,
+            39.3,
+        )
+    }
+
     #[test]
     fn projection_puts_up_at_the_top() {
-        let camera = Camera {
-            position: Vec3::new(0.0, 1.0, 3.9),
-            target: Vec3::new(0.0, 1.0, 0.0),
-            up: Vec3::Y,
-            fov_y_deg: 39.3,
-            near: 0.01,
-            far: 100.0,
-        };
+        let camera = cornell_camera();
         let vp = camera.proj(1.0) * camera.view();
-        let ahead = vp.project_point3(Vec3::new(0.0, 1.0, 0.0));
-        assert!(ahead.x.abs() < 1e-5 && ahead.y.abs() < 1e-5);
+        let ahead = vp.project_point3(camera.target);
+        assert!(ahead.x.abs() < 1e-5 && ahead.y.abs() < 1e-5, "{ahead}");
+        assert!((0.0..1.0).contains(&ahead.z));
         let above = vp.project_point3(Vec3::new(0.0, 1.5, 0.0));
-        assert!(above.y < 0.0, "row 0 is the top, so up is negative NDC y");
-        let right = vp.project_point3(Vec3::new(0.5, 1.0, 0.0));
-        assert!(right.x > 0.0);
+        assert!(
+            above.y < 0.0,
+            "row 0 is the top, so up is negative NDC y: {above}"
+        );
+        let right = vp.project_point3(camera.target + camera.right());
+        assert!(right.x > 0.0, "{right}");
+        assert!(camera.right().abs_diff_eq(Vec3::X, 1e-6));
+        // Half the vertical field of view below the target lands on the bottom edge.
+        let half = (camera.fov_y_deg * 0.5).to_radians().tan() * 3.9;
+        let edge = vp.project_point3(camera.target - Vec3::Y * half);
+        assert!((edge.y - 1.0).abs() < 1e-4, "{edge}");
+    }
+
+    #[test]
+    fn depth_runs_from_zero_at_near_to_one_at_far() {
+        let mut camera = cornell_camera();
+        camera.fit_clip_planes(&Aabb {
+            min: Vec3::new(-1.0, 0.0, -1.0),
+            max: Vec3::new(1.0, 2.0, 1.0),
+        });
+        assert!((camera.near - 12f32.sqrt() * 1e-3).abs() < 1e-6);
+        assert!((camera.far - 4.0 * (3.9 + 12f32.sqrt())).abs() < 1e-4);
+        // In view space, to keep the camera's world position out of the rounding.
+        let depth = |d: f32| camera.proj(1.5).project_point3(Vec3::new(0.0, 0.0, -d)).z;
+        assert!(depth(camera.near).abs() < 1e-6, "{}", depth(camera.near));
+        assert!(
+            (depth(camera.far) - 1.0).abs() < 1e-6,
+            "{}",
+            depth(camera.far)
+        );
     }
 }

@@ -1,4 +1,7 @@
 //! Scenes: OBJ/MTL geometry and materials, textures with mips, camera, lights, animation.
+//!
+//! Pure CPU code: everything the renderer uploads is decoded and laid out here, so the
+//! loaders can be tested without a GPU. The scene file formats are described in `file.rs`.
 
 mod animation;
 mod camera;
@@ -8,6 +11,7 @@ mod obj;
 mod texture;
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use anyhow::{bail, Result};
 use glam::{Mat4, Vec3};
@@ -17,8 +21,11 @@ pub use camera::Camera;
 pub use light::{Light, LightKind};
 pub use texture::{Texture, TextureKind};
 
-/// One vertex. `uv` has v running down the image (row 0 at v = 0): OBJ's v is flipped once
-/// at load time, so textures are sampled as stored in memory.
+/// One vertex, as uploaded to the GPU.
+///
+/// `uv` is stored as `[u, 1 - v]` of the OBJ's texture coordinate: OBJ puts v = 0 at the
+/// bottom of the image, whereas texture memory starts with the top row, so after this single
+/// flip at load time (0, 0) is the top-left texel of row 0 and shaders sample `uv` as is.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Vertex {
@@ -27,7 +34,7 @@ pub struct Vertex {
     pub uv: [f32; 2],
 }
 
-/// An axis-aligned box.
+/// An axis-aligned box. [`Aabb::EMPTY`] (inverted, infinite) is the identity of `union`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
     pub min: Vec3,
@@ -39,6 +46,10 @@ impl Aabb {
         min: Vec3::splat(f32::INFINITY),
         max: Vec3::splat(f32::NEG_INFINITY),
     };
+
+    pub fn is_empty(&self) -> bool {
+        self.min.cmpgt(self.max).any()
+    }
 
     pub fn extend(&mut self, p: Vec3) {
         self.min = self.min.min(p);
@@ -60,8 +71,15 @@ impl Aabb {
         self.max - self.min
     }
 
-    /// The bounds of this box's eight corners after `m`.
+    pub fn diagonal(&self) -> f32 {
+        self.size().length()
+    }
+
+    /// The bounds of this box's eight corners after `m` (conservative under rotation).
     pub fn transformed(&self, m: Mat4) -> Aabb {
+        if self.is_empty() {
+            return *self;
+        }
         let mut out = Aabb::EMPTY;
         for i in 0..8 {
             let corner = Vec3::new(
@@ -75,7 +93,7 @@ impl Aabb {
     }
 }
 
-/// Triangles of one material.
+/// Triangles of one material from one OBJ model.
 #[derive(Clone, Debug)]
 pub struct Mesh {
     pub name: String,
@@ -85,26 +103,34 @@ pub struct Mesh {
     /// Object to world, from the scene file.
     pub transform: Mat4,
     pub animation: Option<Animation>,
+    /// Object-space bounds of this mesh's vertices.
     pub local_bounds: Aabb,
+    /// Object-space bounds of everything its scene-file entry loaded. Animations pivot about
+    /// its centre, so that the many meshes of one OBJ move as one rigid object.
+    pub object_bounds: Aabb,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub name: String,
-    /// Kd.
+    /// Kd (0.8 when the MTL has none, as the references assume).
     pub albedo: Vec3,
+    /// Multiplies `albedo`.
     pub albedo_texture: Option<u32>,
-    /// Ks.
+    /// Ks (zero with [`LoadOptions::diffuse_only`]).
     pub specular: Vec3,
-    /// From Ns: sqrt(2 / (Ns + 2)).
+    /// From Ns: sqrt(2 / (Ns + 2)), the Beckmann-to-Phong correspondence, clamped to
+    /// [0.02, 1].
     pub roughness: f32,
-    /// Ke times the mesh entry's emission_scale: radiance along the winding normal.
+    /// Ke times the scene entry's emission_scale: radiance of a one-sided emitter along the
+    /// winding normal.
     pub emission: Vec3,
-    /// d (1 = opaque).
+    /// d, or 1 - Tr (1 = opaque).
     pub dissolve: f32,
     /// map_d cut-out coverage.
     pub coverage_texture: Option<u32>,
-    /// Tangent-space normal map.
+    /// Tangent-space normal map (`norm`, or a `map_Bump`/`bump` whose file name says it is a
+    /// normal map; height maps are ignored).
     pub normal_texture: Option<u32>,
     /// Ni.
     pub ior: f32,
@@ -144,7 +170,7 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     pub camera: Camera,
     pub lights: Vec<Light>,
-    /// Constant sky radiance.
+    /// Constant sky radiance (zero when the scene has none).
     pub sky: Vec3,
     pub source: PathBuf,
     pub triangle_count: usize,
@@ -153,9 +179,10 @@ pub struct Scene {
 impl Scene {
     /// Loads a `.toml` scene file, a reference `.scene.json`, or a bare `.obj`.
     pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
-        if !path.exists() {
+        if !path.is_file() {
             bail!("scene file not found: {}", path.display());
         }
+        let start = Instant::now();
         let name = path.to_string_lossy().to_ascii_lowercase();
         let mut scene = if name.ends_with(".toml") {
             file::load_toml(path, options)?
@@ -169,15 +196,21 @@ impl Scene {
                 path.display()
             );
         };
-        scene.triangle_count = scene.meshes.iter().map(|m| m.indices.len() / 3).sum();
-        if scene.triangle_count == 0 {
-            bail!("scene has no triangles: {}", path.display());
-        }
         scene.camera.fit_clip_planes(&scene.bounds(0.0));
+        log::info!(
+            "loaded {} in {:.2} s: {} triangles, {} meshes, {} materials, {} textures, {} lights",
+            path.display(),
+            start.elapsed().as_secs_f64(),
+            scene.triangle_count,
+            scene.meshes.len(),
+            scene.materials.len(),
+            scene.textures.len(),
+            scene.lights.len()
+        );
         Ok(scene)
     }
 
-    /// World bounds at time `time_s`.
+    /// World bounds at time `time_s`, animated meshes included.
     pub fn bounds(&self, time_s: f32) -> Aabb {
         (0..self.meshes.len()).fold(Aabb::EMPTY, |b, i| {
             b.union(
@@ -188,11 +221,11 @@ impl Scene {
         })
     }
 
-    /// Object to world of mesh `mesh` at time `time_s`.
+    /// Object to world of mesh `mesh` at time `time_s`: the animation acts in object space.
     pub fn mesh_transform(&self, mesh: usize, time_s: f32) -> Mat4 {
         let m = &self.meshes[mesh];
         match &m.animation {
-            Some(a) => m.transform * a.matrix(&m.local_bounds, time_s),
+            Some(a) => m.transform * a.matrix(&m.object_bounds, time_s),
             None => m.transform,
         }
     }
@@ -209,5 +242,92 @@ impl Scene {
     pub fn is_animated(&self) -> bool {
         self.meshes.iter().any(|m| m.animation.is_some())
             || self.lights.iter().any(|l| l.orbit.is_some())
+    }
+}
+
+/// Fixtures shared by the tests of this module's files.
+#[cfg(test)]
+mod testing {
+    use std::path::{Path, PathBuf};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// The shared scenes and references: `$VOXCONE_SHARED`, else `shared/` beside the
+    /// repository (this file is compiled both from the main crate and from a scratch crate
+    /// one level deeper). `None`, with the reason printed, when absent.
+    pub fn shared_dir() -> Option<PathBuf> {
+        let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let candidates: Vec<PathBuf> = std::env::var_os("VOXCONE_SHARED")
+            .map(PathBuf::from)
+            .into_iter()
+            .chain([manifest.join("../shared"), manifest.join("../../shared")])
+            .collect();
+        let found = candidates
+            .iter()
+            .find(|d| d.join("scenes").is_dir() && d.join("reference").is_dir());
+        if found.is_none() {
+            eprintln!(
+                "skipped: no shared scenes in {candidates:?} (set VOXCONE_SHARED to the folder \
+                 holding scenes/ and reference/)"
+            );
+        }
+        found.cloned()
+    }
+
+    /// A fresh folder under the system temp dir, removed again when dropped.
+    pub struct TempDir(pub PathBuf);
+
+    impl TempDir {
+        pub fn new(name: &str) -> Self {
+            static NEXT: AtomicUsize = AtomicUsize::new(0);
+            let dir = std::env::temp_dir().join(format!(
+                "voxcone-scene-{}-{}-{name}",
+                std::process::id(),
+                NEXT.fetch_add(1, Ordering::Relaxed)
+            ));
+            std::fs::create_dir_all(&dir).unwrap();
+            Self(dir)
+        }
+
+        pub fn write(&self, name: &str, text: &str) -> PathBuf {
+            let path = self.0.join(name);
+            std::fs::write(&path, text).unwrap();
+            path
+        }
+    }
+
+    impl Drop for TempDir {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    /// A unit quad in z = 0 (two triangles, counter-clockwise seen from +Z) with material
+    /// `lamp`: Kd, Ke, Ks, Ns and a 2x2 PNG as map_Kd and map_d.
+    pub fn write_quad(dir: &Path) -> PathBuf {
+        image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 128, 0, 255]))
+            .save(dir.join("tex.png"))
+            .unwrap();
+        let write = |name: &str, text: &str| {
+            std::fs::write(dir.join(name), text).unwrap();
+            dir.join(name)
+        };
+        write(
+            "quad.mtl",
+            "newmtl lamp\nKd 0.5 0.5 0.5\nKe 2 3 4\nKs 0.5 0.5 0.5\nNs 98\nNi 1.5\nTr 0.25\n\
+             map_Kd tex.png\nmap_d -imfchan m tex.png\n",
+        );
+        write(
+            "quad.obj",
+            "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+             vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl lamp\nf 1/1 2/2 3/3 4/4\n",
+        )
+    }
+
+    /// `format!("{e:#}")` of the error of `result`, which must have failed.
+    pub fn error_text<T>(result: anyhow::Result<T>) -> String {
+        match result {
+            Ok(_) => panic!("expected an error"),
+            Err(e) => format!("{e:#}"),
+        }
     }
 }

@@ -1,6 +1,9 @@
 //! OBJ + MTL loading through `tobj`.
 
+use std::cell::RefCell;
 use std::collections::HashMap;
+use std::fs::File;
+use std::io::BufReader;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -10,10 +13,326 @@ use rayon::prelude::*;
 
 use super::{Aabb, Animation, LoadOptions, Material, Mesh, Texture, TextureKind, Vertex};
 
-/// Textures requested by materials, decoded together (in parallel) at the end.
+/// What a scene file says about one OBJ.
+pub struct ObjEntry<'a> {
+    pub path: &'a Path,
+    pub transform: Mat4,
+    pub emission_scale: f32,
+    pub animation: Option<Animation>,
+}
+
+/// The meshes and materials of a scene's OBJs. Textures are only collected while the OBJs
+/// are read, so that [`Geometry::finish`] can decode all of them in parallel.
 #[derive(Default)]
-pub struct TextureRequests {
+pub struct Geometry {
+    pub meshes: Vec<Mesh>,
+    pub materials: Vec<Material>,
+    textures: TextureRequests,
+    /// Shared by every group without a material, in every OBJ of the scene.
+    default_material: Option<u32>,
+}
+
+impl Geometry {
+    /// Reads one OBJ with its MTLs; its materials are appended after those already loaded,
+    /// so that equal names in different OBJs stay different materials.
+    pub fn add_obj(&mut self, entry: &ObjEntry, options: &LoadOptions) -> Result<()> {
+        let path = entry.path;
+        let start = Instant::now();
+        let (models, obj_materials, material_dirs) = parse(path)?;
+
+        let first_material = self.materials.len() as u32;
+        for (m, dir) in obj_materials.iter().zip(&material_dirs) {
+            let material =
+                convert_material(m, dir, entry.emission_scale, options, &mut self.textures)
+                    .with_context(|| format!("in the materials of {}", path.display()))?;
+            self.materials.push(material);
+        }
+
+        let mut meshes = Vec::new();
+        for model in &models {
+            let Some(ModelGeometry {
+                vertices,
+                indices,
+                bounds,
+            }) = model_geometry(model).with_context(|| format!("in OBJ {}", path.display()))?
+            else {
+                continue;
+            };
+            let material = match model.mesh.material_id {
+                Some(id) if id < obj_materials.len() => first_material + id as u32,
+                _ => self.default_material(),
+            };
+            meshes.push(Mesh {
+                name: model.name.clone(),
+                vertices,
+                indices,
+                material,
+                transform: entry.transform,
+                animation: entry.animation,
+                local_bounds: bounds,
+                object_bounds: bounds,
+            });
+        }
+        let object_bounds = meshes
+            .iter()
+            .fold(Aabb::EMPTY, |b, m| b.union(&m.local_bounds));
+        for mesh in &mut meshes {
+            mesh.object_bounds = object_bounds;
+        }
+        let triangles: usize = meshes.iter().map(|m| m.indices.len() / 3).sum();
+        log::info!(
+            "loading {}: {triangles} triangles, {} materials ({:.2} s)",
+            path.file_name()
+                .unwrap_or(path.as_os_str())
+                .to_string_lossy(),
+            obj_materials.len(),
+            start.elapsed().as_secs_f64()
+        );
+        self.meshes.extend(meshes);
+        Ok(())
+    }
+
+    fn default_material(&mut self) -> u32 {
+        *self.default_material.get_or_insert_with(|| {
+            self.materials.push(Material::default_grey());
+            self.materials.len() as u32 - 1
+        })
+    }
+
+    /// Decodes every requested texture (in parallel) and builds its mips.
+    pub fn finish(self) -> Result<(Vec<Mesh>, Vec<Material>, Vec<Texture>)> {
+        let textures = self.textures.decode()?;
+        Ok((self.meshes, self.materials, textures))
+    }
+}
+
+/// Parses an OBJ and its MTLs: models, materials, and the folder of the MTL each material
+/// came from (its texture paths are relative to that).
+fn parse(path: &Path) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>, Vec<PathBuf>)> {
+    let file = File::open(path).with_context(|| format!("cannot open OBJ {}", path.display()))?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    // tobj keeps going after a failed mtllib and only reports an error when no MTL loaded at
+    // all, so every failure is recorded here to name the file.
+    let failures = RefCell::new(Vec::new());
+    let material_dirs = RefCell::new(Vec::new());
+    // GPU_LOAD_OPTIONS: triangulated, one index for position, normal and uv, and points and
+    // lines dropped (they are not surfaces).
+    let (models, materials) =
+        tobj::load_obj_buf(&mut BufReader::new(file), &tobj::GPU_LOAD_OPTIONS, |mtl| {
+            let mtl_path = dir.join(mtl);
+            let result = tobj::load_mtl(&mtl_path);
+            match &result {
+                Ok((materials, _)) => {
+                    let mtl_dir = mtl_path.parent().unwrap_or(Path::new("")).to_path_buf();
+                    material_dirs
+                        .borrow_mut()
+                        .extend(std::iter::repeat_n(mtl_dir, materials.len()));
+                }
+                Err(e) => failures.borrow_mut().push((mtl_path, *e)),
+            }
+            result
+        })
+        .map_err(|e| anyhow!("cannot parse OBJ {}: {e}", path.display()))?;
+    if let Some((mtl, e)) = failures.into_inner().first() {
+        if !mtl.is_file() {
+            bail!(
+                "MTL file {} (mtllib of {}) not found",
+                mtl.display(),
+                path.display()
+            );
+        }
+        bail!(
+            "cannot parse MTL {} (mtllib of {}): {e}",
+            mtl.display(),
+            path.display()
+        );
+    }
+    let materials =
+        materials.map_err(|e| anyhow!("cannot load the MTLs of {}: {e}", path.display()))?;
+    Ok((models, materials, material_dirs.into_inner()))
+}
+
+fn convert_material(
+    m: &tobj::Material,
+    dir: &Path,
+    emission_scale: f32,
+    options: &LoadOptions,
+    textures: &mut TextureRequests,
+) -> Result<Material> {
+    let name = &m.name;
+    let mut texture =
+        |statement: &str, kind| textures.request(texture_path(dir, statement), kind, name);
+    let albedo_texture = m
+        .diffuse_texture
+        .as_deref()
+        .map(|t| texture(t, TextureKind::Albedo))
+        .transpose()?;
+    let coverage_texture = m
+        .dissolve_texture
+        .as_deref()
+        .map(|t| texture(t, TextureKind::Coverage))
+        .transpose()?;
+    let normal_map = m.unknown_param.get("norm").map(String::as_str).or_else(|| {
+        m.normal_texture
+            .as_deref()
+            .filter(|t| looks_like_normal_map(t))
+    });
+    let normal_texture = match normal_map {
+        Some(t) if !options.no_normal_maps => Some(texture(t, TextureKind::Normal)?),
+        _ => None,
+    };
+    let dissolve = match (m.dissolve, m.unknown_param.get("Tr")) {
+        (Some(d), _) => d,
+        (None, Some(tr)) => {
+            let tr: f32 = first_word(tr)
+                .parse()
+                .with_context(|| format!("material {name:?}: Tr {tr:?} is not a number"))?;
+            1.0 - tr
+        }
+        (None, None) => 1.0,
+    };
+    // MTL's default Ns is 0, which is the roughest surface.
+    let shininess = m.shininess.unwrap_or(0.0).max(0.0);
+    let vec3 = |v: Option<[f32; 3]>| v.map_or(Vec3::ZERO, Vec3::from);
+    Ok(Material {
+        name: name.clone(),
+        albedo: m.diffuse.map_or(Vec3::splat(0.8), Vec3::from),
+        albedo_texture,
+        specular: if options.diffuse_only {
+            Vec3::ZERO
+        } else {
+            vec3(m.specular)
+        },
+        roughness: (2.0 / (shininess + 2.0)).sqrt().clamp(0.02, 1.0),
+        emission: vec3(m.emissive) * emission_scale,
+        dissolve: dissolve.clamp(0.0, 1.0),
+        coverage_texture,
+        normal_texture,
+        ior: m.optical_density.unwrap_or(1.0),
+    })
+}
+
+fn first_word(s: &str) -> &str {
+    s.split_whitespace().next().unwrap_or("")
+}
+
+/// The file of an MTL texture statement, relative to the MTL's folder. Options such as
+/// `-bm 1` come before the file name, so the last word is the file unless the whole
+/// statement names an existing file (a name with spaces).
+fn texture_path(dir: &Path, statement: &str) -> PathBuf {
+    let statement = statement.replace('\\', "/");
+    let whole = dir.join(&statement);
+    if whole.is_file() {
+        return whole;
+    }
+    dir.join(statement.split_whitespace().last().unwrap_or(&statement))
+}
+
+/// Is this map_Bump/bump a tangent-space normal map? Height maps are ignored, and only the
+/// file name tells them apart.
+fn looks_like_normal_map(statement: &str) -> bool {
+    let name = statement
+        .rsplit(['/', '\\'])
+        .next()
+        .unwrap_or(statement)
+        .to_ascii_lowercase();
+    name.contains("normal") || name.contains("_nrm") || name.contains("_norm")
+}
+
+struct ModelGeometry {
+    vertices: Vec<Vertex>,
+    indices: Vec<u32>,
+    bounds: Aabb,
+}
+
+/// The triangles of one OBJ model, or `None` for a model without any of non-zero area.
+fn model_geometry(model: &tobj::Model) -> Result<Option<ModelGeometry>> {
+    let mesh = &model.mesh;
+    let count = mesh.positions.len() / 3;
+    if mesh.positions.iter().any(|p| !p.is_finite()) {
+        bail!(
+            "model {:?} has a vertex position that is not a finite number",
+            model.name
+        );
+    }
+    if mesh.indices.iter().any(|&i| i as usize >= count) {
+        bail!(
+            "model {:?} indexes a vertex that does not exist",
+            model.name
+        );
+    }
+    let position = |i: u32| Vec3::from_slice(&mesh.positions[3 * i as usize..][..3]);
+    let has_uvs = mesh.texcoords.len() == 2 * count;
+    let uv = |i: u32| {
+        if has_uvs {
+            [
+                mesh.texcoords[2 * i as usize],
+                1.0 - mesh.texcoords[2 * i as usize + 1],
+            ]
+        } else {
+            [0.0, 0.0]
+        }
+    };
+    let file_normal = |i: u32| Vec3::from_slice(&mesh.normals[3 * i as usize..][..3]);
+    let has_normals = mesh.normals.len() == 3 * count
+        && (0..count as u32).all(|i| file_normal(i).length_squared() > 1e-24);
+    // Zero-area triangles are dropped, as the references do: they cover no pixel and
+    // have no normal.
+    let triangles: Vec<([u32; 3], Vec3)> = mesh
+        .indices
+        .chunks_exact(3)
+        .filter_map(|t| {
+            let t = [t[0], t[1], t[2]];
+            let [p0, p1, p2] = t.map(position);
+            let n = (p1 - p0).cross(p2 - p0);
+            (n != Vec3::ZERO).then(|| (t, n.normalize_or(Vec3::Z)))
+        })
+        .collect();
+    if triangles.is_empty() {
+        return Ok(None);
+    }
+
+    let (vertices, indices): (Vec<Vertex>, Vec<u32>) = if has_normals {
+        let vertices = (0..count as u32)
+            .map(|i| Vertex {
+                position: position(i).to_array(),
+                normal: file_normal(i).normalize().to_array(),
+                uv: uv(i),
+            })
+            .collect();
+        (vertices, triangles.iter().flat_map(|(t, _)| *t).collect())
+    } else {
+        // Flat normals from the winding (counter-clockwise = front), as the references use
+        // for OBJs without normals; each corner gets its own vertex.
+        let vertices: Vec<Vertex> = triangles
+            .iter()
+            .flat_map(|&(t, n)| {
+                t.map(|i| Vertex {
+                    position: position(i).to_array(),
+                    normal: n.to_array(),
+                    uv: uv(i),
+                })
+            })
+            .collect();
+        let indices = (0..vertices.len() as u32).collect();
+        (vertices, indices)
+    };
+    let bounds = indices.iter().fold(Aabb::EMPTY, |mut b, &i| {
+        b.extend(Vec3::from(vertices[i as usize].position));
+        b
+    });
+    Ok(Some(ModelGeometry {
+        vertices,
+        indices,
+        bounds,
+    }))
+}
+
+/// Textures requested by materials, each (file, kind) once.
+#[derive(Default)]
+struct TextureRequests {
     index: HashMap<(PathBuf, TextureKind), u32>,
+    /// File, kind, and the first material that asked (to name it in errors).
     list: Vec<(PathBuf, TextureKind, String)>,
 }
 
@@ -26,15 +345,16 @@ impl TextureRequests {
             );
         }
         let key = (path.canonicalize().unwrap_or(path), kind);
-        let next = self.list.len() as u32;
-        Ok(*self.index.entry(key.clone()).or_insert_with(|| {
-            self.list.push((key.0, kind, material.to_string()));
-            next
-        }))
+        if let Some(&index) = self.index.get(&key) {
+            return Ok(index);
+        }
+        let index = self.list.len() as u32;
+        self.list.push((key.0.clone(), kind, material.to_string()));
+        self.index.insert(key, index);
+        Ok(index)
     }
 
-    /// Decodes every requested texture and builds its mips.
-    pub fn decode(self) -> Result<Vec<Texture>> {
+    fn decode(self) -> Result<Vec<Texture>> {
         if self.list.is_empty() {
             return Ok(Vec::new());
         }
@@ -58,215 +378,245 @@ impl TextureRequests {
     }
 }
 
-/// What a scene file says about one OBJ.
-pub struct ObjEntry<'a> {
-    pub path: &'a Path,
-    pub transform: Mat4,
-    pub emission_scale: f32,
-    pub animation: Option<Animation>,
-}
+#[cfg(test)]
+mod tests {
+    use std::time::Instant;
 
-fn mtllib_names(obj: &Path) -> Vec<String> {
-    std::fs::read_to_string(obj)
-        .map(|text| {
-            text.lines()
-                .filter_map(|l| l.trim().strip_prefix("mtllib "))
-                .map(|s| s.trim().to_string())
-                .collect()
-        })
-        .unwrap_or_default()
-}
+    use super::super::testing::{error_text, shared_dir, write_quad, TempDir};
+    use super::*;
 
-/// A texture path in an MTL statement, relative to the MTL's folder; options such as
-/// `-bm 1` before the file name are skipped.
-fn texture_path(dir: &Path, statement: &str) -> PathBuf {
-    let name = statement.split_whitespace().last().unwrap_or(statement);
-    dir.join(name.replace('\\', "/"))
-}
-
-/// Is this map_Bump/bump a tangent-space normal map (rather than a height map)?
-fn looks_like_normal_map(name: &str) -> bool {
-    let lower = name.to_ascii_lowercase();
-    lower.contains("normal") || lower.contains("_nrm") || lower.contains("_norm")
-}
-
-/// Loads one OBJ; materials are appended after `material_offset` existing ones.
-pub fn load(
-    entry: &ObjEntry,
-    options: &LoadOptions,
-    material_offset: u32,
-    textures: &mut TextureRequests,
-) -> Result<(Vec<Mesh>, Vec<Material>)> {
-    let path = entry.path;
-    if !path.is_file() {
-        bail!("OBJ file not found: {}", path.display());
+    fn load(
+        path: &Path,
+        options: &LoadOptions,
+    ) -> Result<(Vec<Mesh>, Vec<Material>, Vec<Texture>)> {
+        let mut geometry = Geometry::default();
+        let entry = ObjEntry {
+            path,
+            transform: Mat4::IDENTITY,
+            emission_scale: 1.0,
+            animation: None,
+        };
+        geometry.add_obj(&entry, options)?;
+        geometry.finish()
     }
-    let start = Instant::now();
-    let load_options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ..Default::default()
-    };
-    let (models, materials) = tobj::load_obj(path, &load_options)
-        .map_err(|e| anyhow!("cannot parse OBJ {}: {e}", path.display()))?;
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let obj_materials = match materials {
-        Ok(m) => m,
-        Err(e) => {
-            let libs = mtllib_names(path);
-            if let Some(missing) = libs.iter().find(|l| !dir.join(l).is_file()) {
-                bail!(
-                    "MTL file {} (mtllib of {}) not found",
-                    dir.join(missing).display(),
-                    path.display()
-                );
-            }
-            if libs.is_empty() {
-                Vec::new()
-            } else {
-                bail!(
-                    "cannot parse MTL {} of {}: {e}",
-                    libs.join(", "),
-                    path.display()
-                );
-            }
+
+    #[test]
+    fn quad_materials_uvs_and_flat_normals() {
+        let dir = TempDir::new("quad");
+        let obj = write_quad(&dir.0);
+        let (meshes, materials, textures) = load(&obj, &LoadOptions::default()).unwrap();
+        assert_eq!(meshes.len(), 1);
+        let mesh = &meshes[0];
+        assert_eq!(mesh.indices.len(), 6);
+        for v in &mesh.vertices {
+            assert_eq!(v.normal, [0.0, 0.0, 1.0], "counter-clockwise seen from +Z");
+            // OBJ v = 0 at the bottom of the image becomes row coordinate 1.
+            assert_eq!(v.uv[1], 1.0 - v.position[1]);
         }
-    };
-
-    let mut materials = Vec::new();
-    for m in &obj_materials {
-        let name = &m.name;
-        let vec3 = |v: Option<[f32; 3]>| v.map_or(Vec3::ZERO, Vec3::from);
-        let ke = m
-            .emissive
-            .map(Vec3::from)
-            .or_else(|| {
-                m.unknown_param.get("Ke").and_then(|s| {
-                    let v: Vec<f32> = s
-                        .split_whitespace()
-                        .filter_map(|x| x.parse().ok())
-                        .collect();
-                    (v.len() == 3).then(|| Vec3::new(v[0], v[1], v[2]))
-                })
-            })
-            .unwrap_or(Vec3::ZERO);
-        let albedo_texture = m
-            .diffuse_texture
-            .as_ref()
-            .map(|t| textures.request(texture_path(dir, t), TextureKind::Albedo, name))
-            .transpose()?;
-        let coverage_texture = m
-            .dissolve_texture
-            .as_ref()
-            .map(|t| textures.request(texture_path(dir, t), TextureKind::Coverage, name))
-            .transpose()?;
-        let normal_name = m.unknown_param.get("norm").cloned().or_else(|| {
-            m.normal_texture
-                .clone()
-                .filter(|t| looks_like_normal_map(t))
-        });
-        let normal_texture = match normal_name {
-            Some(t) if !options.no_normal_maps => {
-                Some(textures.request(texture_path(dir, &t), TextureKind::Normal, name)?)
-            }
-            _ => None,
-        };
-        let shininess = m.shininess.unwrap_or(10.0).max(0.0);
-        materials.push(Material {
-            name: name.clone(),
-            albedo: m.diffuse.map_or(Vec3::splat(0.8), Vec3::from),
-            albedo_texture,
-            specular: if options.diffuse_only {
-                Vec3::ZERO
-            } else {
-                vec3(m.specular)
-            },
-            roughness: (2.0 / (shininess + 2.0)).sqrt().clamp(0.02, 1.0),
-            emission: ke * entry.emission_scale,
-            dissolve: m.dissolve.unwrap_or(1.0).clamp(0.0, 1.0),
-            coverage_texture,
-            normal_texture,
-            ior: m.optical_density.unwrap_or(1.0),
-        });
+        let lamp = &materials[mesh.material as usize];
+        assert_eq!(lamp.albedo, Vec3::splat(0.5));
+        assert_eq!(lamp.emission, Vec3::new(2.0, 3.0, 4.0));
+        assert_eq!(lamp.ior, 1.5);
+        assert_eq!(lamp.dissolve, 0.75, "Tr = 1 - d");
+        assert!((lamp.roughness - 0.02f32.sqrt()).abs() < 1e-6);
+        assert_eq!(textures.len(), 2, "same file as map_Kd and map_d");
+        assert_eq!(
+            textures[lamp.albedo_texture.unwrap() as usize].kind,
+            TextureKind::Albedo
+        );
+        assert_eq!(
+            textures[lamp.coverage_texture.unwrap() as usize].kind,
+            TextureKind::Coverage
+        );
+        assert_eq!(std::mem::size_of::<Vertex>(), 32);
     }
-    let mut default_material = None;
 
-    let mut meshes = Vec::new();
-    for model in models {
-        let mesh = &model.mesh;
-        if mesh.indices.is_empty() {
-            continue;
+    #[test]
+    fn groups_without_material_share_one_grey() {
+        let dir = TempDir::new("grey");
+        let obj = dir.write(
+            "two.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 2\nvn 0 0 2\nvn 0 0 2\n\
+             o a\nf 1//1 2//2 3//3\no b\nf 3//3 2//2 1//1\n",
+        );
+        let (meshes, materials, _) = load(&obj, &LoadOptions::default()).unwrap();
+        assert_eq!(meshes.len(), 2);
+        assert_eq!(materials, vec![Material::default_grey()]);
+        assert!(meshes.iter().all(|m| m.material == 0));
+        assert_eq!(
+            meshes[0].vertices[0].normal,
+            [0.0, 0.0, 1.0],
+            "file normals, normalised"
+        );
+        assert_eq!(
+            meshes[0].vertices.len(),
+            3,
+            "shared vertices when the file has normals"
+        );
+    }
+
+    #[test]
+    fn zero_area_triangles_are_dropped() {
+        let dir = TempDir::new("degenerate");
+        let obj = dir.write(
+            "d.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\no flat\nf 1 4 2\n",
+        );
+        let (meshes, _, _) = load(&obj, &LoadOptions::default()).unwrap();
+        assert_eq!(
+            meshes.len(),
+            1,
+            "the model of only a zero-area triangle is gone"
+        );
+        assert_eq!(meshes[0].indices.len(), 3);
+        assert_eq!(meshes[0].local_bounds.max, Vec3::new(1.0, 1.0, 0.0));
+    }
+
+    #[test]
+    fn normal_maps_and_height_maps() {
+        let dir = TempDir::new("bump");
+        for name in ["h.png", "wall_nrm.png", "n.png"] {
+            image::RgbaImage::new(1, 1).save(dir.0.join(name)).unwrap();
         }
-        let material = match mesh.material_id {
-            Some(id) if id < materials.len() => material_offset + id as u32,
-            _ => *default_material.get_or_insert_with(|| {
-                materials.push(Material::default_grey());
-                material_offset + materials.len() as u32 - 1
-            }),
+        dir.write(
+            "m.mtl",
+            "newmtl height\nbump -bm 0.5 h.png\nnewmtl bump\nmap_Bump wall_nrm.png\n\
+             newmtl norm\nnorm n.png\nmap_Bump h.png\n",
+        );
+        let obj = dir.write(
+            "m.obj",
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl height\nf 1 2 3\n",
+        );
+        let (_, materials, textures) = load(&obj, &LoadOptions::default()).unwrap();
+        assert_eq!(materials[0].normal_texture, None, "height maps are ignored");
+        let file = |m: &Material| textures[m.normal_texture.unwrap() as usize].path.clone();
+        assert!(file(&materials[1]).ends_with("wall_nrm.png"));
+        assert!(file(&materials[2]).ends_with("n.png"));
+        let options = LoadOptions {
+            no_normal_maps: true,
+            diffuse_only: true,
         };
-        let vertex_count = mesh.positions.len() / 3;
-        let has_normals = mesh.normals.len() == mesh.positions.len();
-        let has_uvs = mesh.texcoords.len() == vertex_count * 2;
-        let position = |i: usize| Vec3::from_slice(&mesh.positions[3 * i..3 * i + 3]);
-        let mut local_bounds = Aabb::EMPTY;
-        let (vertices, indices) = if has_normals {
-            let vertices: Vec<Vertex> = (0..vertex_count)
-                .map(|i| {
-                    local_bounds.extend(position(i));
-                    Vertex {
-                        position: position(i).to_array(),
-                        normal: Vec3::from_slice(&mesh.normals[3 * i..3 * i + 3])
-                            .normalize_or_zero()
-                            .to_array(),
-                        uv: if has_uvs {
-                            [mesh.texcoords[2 * i], 1.0 - mesh.texcoords[2 * i + 1]]
-                        } else {
-                            [0.0, 0.0]
-                        },
-                    }
-                })
-                .collect();
-            (vertices, mesh.indices.clone())
-        } else {
-            // No normals in the file: flat normals from the winding, one vertex per corner.
-            let mut vertices = Vec::with_capacity(mesh.indices.len());
-            for tri in mesh.indices.chunks_exact(3) {
-                let p = [tri[0], tri[1], tri[2]].map(|i| position(i as usize));
-                let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-                for (k, &i) in tri.iter().enumerate() {
-                    local_bounds.extend(p[k]);
-                    let i = i as usize;
-                    vertices.push(Vertex {
-                        position: p[k].to_array(),
-                        normal: n.to_array(),
-                        uv: if has_uvs {
-                            [mesh.texcoords[2 * i], 1.0 - mesh.texcoords[2 * i + 1]]
-                        } else {
-                            [0.0, 0.0]
-                        },
-                    });
-                }
-            }
-            let indices = (0..vertices.len() as u32).collect();
-            (vertices, indices)
-        };
-        meshes.push(Mesh {
-            name: model.name.clone(),
-            vertices,
-            indices,
-            material,
-            transform: entry.transform,
-            animation: entry.animation,
-            local_bounds,
-        });
+        let (_, materials, textures) = load(&obj, &options).unwrap();
+        assert!(textures.is_empty() && materials.iter().all(|m| m.normal_texture.is_none()));
     }
-    let triangles: usize = meshes.iter().map(|m| m.indices.len() / 3).sum();
-    log::info!(
-        "parsed {}: {} triangles, {} materials in {:.2} s",
-        path.display(),
-        triangles,
-        materials.len(),
-        start.elapsed().as_secs_f64()
-    );
-    Ok((meshes, materials))
+
+    #[test]
+    fn errors_name_the_file() {
+        let dir = TempDir::new("errors");
+        let message = error_text(load(&dir.0.join("absent.obj"), &LoadOptions::default()));
+        assert!(message.contains("absent.obj"), "{message}");
+
+        let bad = dir.write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 zz\n");
+        let message = error_text(load(&bad, &LoadOptions::default()));
+        assert!(
+            message.contains("bad.obj") && message.contains("parse"),
+            "{message}"
+        );
+
+        let infinite = dir.write("inf.obj", "v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n");
+        let message = error_text(load(&infinite, &LoadOptions::default()));
+        assert!(
+            message.contains("inf.obj") && message.contains("finite"),
+            "{message}"
+        );
+
+        let no_mtl = dir.write(
+            "m.obj",
+            "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        );
+        let message = error_text(load(&no_mtl, &LoadOptions::default()));
+        assert!(
+            message.contains("nowhere.mtl") && message.contains("not found"),
+            "{message}"
+        );
+
+        dir.write("broken.mtl", "newmtl x\nKd 1 one 1\n");
+        let broken = dir.write(
+            "b.obj",
+            "mtllib broken.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        );
+        let message = error_text(load(&broken, &LoadOptions::default()));
+        assert!(
+            message.contains("broken.mtl") && message.contains("parse"),
+            "{message}"
+        );
+
+        dir.write("t.mtl", "newmtl brick\nmap_Kd gone.png\n");
+        let texture = dir.write(
+            "t.obj",
+            "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl brick\nf 1 2 3\n",
+        );
+        let message = error_text(load(&texture, &LoadOptions::default()));
+        for needle in ["gone.png", "brick", "not found", "t.obj"] {
+            assert!(message.contains(needle), "{message} lacks {needle}");
+        }
+
+        std::fs::write(dir.0.join("junk.png"), b"not a png").unwrap();
+        dir.write("j.mtl", "newmtl junk\nmap_Kd junk.png\n");
+        let junk = dir.write(
+            "j.obj",
+            "mtllib j.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl junk\nf 1 2 3\n",
+        );
+        let message = error_text(load(&junk, &LoadOptions::default()));
+        assert!(
+            message.contains("junk.png") && message.contains("\"junk\""),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn cornell_box() {
+        let Some(shared) = shared_dir() else { return };
+        let obj = shared.join("scenes/cornell_box/CornellBox-Original.obj");
+        let (meshes, materials, textures) = load(&obj, &LoadOptions::default()).unwrap();
+        let triangles: usize = meshes.iter().map(|m| m.indices.len() / 3).sum();
+        assert_eq!(triangles, 36);
+        assert_eq!(meshes.len(), 8);
+        assert_eq!(materials.len(), 8);
+        assert!(textures.is_empty());
+        let bounds = meshes
+            .iter()
+            .fold(Aabb::EMPTY, |b, m| b.union(&m.local_bounds));
+        assert!(
+            bounds.min.abs_diff_eq(Vec3::new(-1.0, 0.0, -1.0), 0.05),
+            "{bounds:?}"
+        );
+        assert!(
+            bounds.max.abs_diff_eq(Vec3::new(1.0, 2.0, 1.0), 0.05),
+            "{bounds:?}"
+        );
+        let light = materials.iter().find(|m| m.emission != Vec3::ZERO).unwrap();
+        assert_eq!(light.emission, Vec3::new(17.0, 12.0, 4.0));
+        // The floor faces up (into the box) by its winding.
+        let floor = meshes.iter().find(|m| m.name == "floor").unwrap();
+        assert!(floor.vertices.iter().all(|v| v.normal[1] > 0.99));
+    }
+
+    #[test]
+    fn sponza() {
+        let Some(shared) = shared_dir() else { return };
+        let obj = shared.join("scenes/crytek_sponza/sponza.obj");
+        let start = Instant::now();
+        let (meshes, materials, textures) = load(&obj, &LoadOptions::default()).unwrap();
+        eprintln!(
+            "sponza: {} meshes, {} materials, {} textures, loaded in {:.2} s",
+            meshes.len(),
+            materials.len(),
+            textures.len(),
+            start.elapsed().as_secs_f64()
+        );
+        let triangles: usize = meshes.iter().map(|m| m.indices.len() / 3).sum();
+        assert!((260_000..265_000).contains(&triangles), "{triangles}");
+        assert!(materials.len() >= 24);
+        assert!(textures.iter().any(|t| t.kind == TextureKind::Coverage));
+        assert!(textures.iter().any(|t| t.kind == TextureKind::Normal));
+        for t in &textures {
+            let levels = 32 - t.width.max(t.height).leading_zeros();
+            assert_eq!(t.mips.len(), levels as usize, "{}", t.path.display());
+            assert_eq!(t.mips.last().unwrap().len(), 4);
+        }
+        assert!(meshes
+            .iter()
+            .all(|m| (m.material as usize) < materials.len()));
+    }
 }

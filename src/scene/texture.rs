@@ -1,17 +1,24 @@
 //! Texture decoding and mip chains.
+//!
+//! Mips are built on the CPU so that each kind is filtered in the space where averaging
+//! is meaningful: albedo in linear light, normals as unit vectors.
 
 use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
 
-use anyhow::{Context as _, Result};
+use anyhow::{ensure, Context as _, Result};
+use glam::{Vec3, Vec4};
+use image::DynamicImage;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TextureKind {
-    /// sRGB colour (map_Kd).
+    /// sRGB colour (map_Kd); alpha is linear.
     Albedo,
-    /// Cut-out coverage (map_d): the alpha channel if the image has one, else its
-    /// luminance, in all four channels, linear.
+    /// Cut-out coverage (map_d), linear, in all four channels: the alpha channel when the
+    /// image has one that is not entirely opaque, else the luminance (Rec. 601 luma, as
+    /// PIL's `convert("L")` in the path-traced references).
     Coverage,
-    /// Tangent-space normal map, linear.
+    /// Tangent-space normal map, linear: xyz = 2 * rgb - 1.
     Normal,
 }
 
@@ -21,129 +28,42 @@ pub struct Texture {
     pub kind: TextureKind,
     pub width: u32,
     pub height: u32,
-    /// RGBA8 levels down to 1x1; `mips[0]` is full size.
+    /// RGBA8 levels down to 1x1; `mips[0]` is full size and level `i + 1` is
+    /// `max(1, floor(size_i / 2))` on each axis.
     pub mips: Vec<Vec<u8>>,
-}
-
-fn srgb_to_linear_lut() -> [f32; 256] {
-    let mut lut = [0.0; 256];
-    for (i, v) in lut.iter_mut().enumerate() {
-        let c = i as f32 / 255.0;
-        *v = if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        };
-    }
-    lut
-}
-
-fn linear_to_srgb_byte(x: f32) -> u8 {
-    (crate::imageio::srgb_encode(x) * 255.0).round() as u8
-}
-
-/// Halves an RGBA image (floor, at least 1), averaging the up-to-2x2 source texels in the
-/// space given by `decode`/`encode` per channel (alpha always linear).
-fn downsample(
-    src: &[u8],
-    w: u32,
-    h: u32,
-    decode: &dyn Fn(usize, u8) -> f32,
-    encode: &dyn Fn(usize, f32) -> u8,
-) -> (Vec<u8>, u32, u32) {
-    let nw = (w / 2).max(1);
-    let nh = (h / 2).max(1);
-    let mut out = vec![0u8; (nw * nh * 4) as usize];
-    for y in 0..nh {
-        for x in 0..nw {
-            let xs = [(2 * x).min(w - 1), (2 * x + 1).min(w - 1)];
-            let ys = [(2 * y).min(h - 1), (2 * y + 1).min(h - 1)];
-            for c in 0..4 {
-                let mut sum = 0.0;
-                for &sy in &ys {
-                    for &sx in &xs {
-                        sum += decode(c, src[((sy * w + sx) * 4) as usize + c]);
-                    }
-                }
-                out[((y * nw + x) * 4) as usize + c] = encode(c, sum / 4.0);
-            }
-        }
-    }
-    (out, nw, nh)
 }
 
 impl Texture {
     pub fn load(path: &Path, kind: TextureKind) -> Result<Texture> {
-        let image =
-            image::open(path).with_context(|| format!("cannot read texture {}", path.display()))?;
-        let has_alpha = image.color().has_alpha();
-        let mut rgba = image.to_rgba8();
-        let (width, height) = rgba.dimensions();
-        if kind == TextureKind::Coverage {
-            for p in rgba.pixels_mut() {
-                let c = if has_alpha {
-                    p[3]
-                } else {
-                    (0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2]))
-                        .round() as u8
-                };
-                p.0 = [c; 4];
-            }
-        }
-        let mut mips = vec![rgba.into_raw()];
-        let lut = srgb_to_linear_lut();
-        let (mut w, mut h) = (width, height);
-        while w > 1 || h > 1 {
-            let src = mips.last().unwrap();
-            let (next, nw, nh) = match kind {
-                TextureKind::Albedo => downsample(
-                    src,
-                    w,
-                    h,
-                    &|c, v| {
-                        if c < 3 {
-                            lut[v as usize]
-                        } else {
-                            f32::from(v) / 255.0
-                        }
-                    },
-                    &|c, x| {
-                        if c < 3 {
-                            linear_to_srgb_byte(x)
-                        } else {
-                            (x * 255.0).round() as u8
-                        }
-                    },
-                ),
-                TextureKind::Coverage | TextureKind::Normal => {
-                    downsample(src, w, h, &|_, v| f32::from(v) / 255.0, &|_, x| {
-                        (x * 255.0).round() as u8
-                    })
-                }
-            };
-            mips.push(next);
-            w = nw;
-            h = nh;
-        }
-        if kind == TextureKind::Normal {
-            // Averaged normals shrink; renormalise each level's vectors.
-            for level in mips.iter_mut().skip(1) {
-                for p in level.chunks_exact_mut(4) {
-                    let v = glam::Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32) / 127.5 - 1.0;
-                    let n = v.normalize_or_zero();
-                    for c in 0..3 {
-                        p[c] = ((n[c] + 1.0) * 127.5).round().clamp(0.0, 255.0) as u8;
-                    }
-                }
-            }
-        }
-        Ok(Texture {
-            path: path.to_path_buf(),
+        let image = image::ImageReader::open(path)
+            .and_then(|r| r.with_guessed_format())
+            .with_context(|| format!("cannot read texture {}", path.display()))?
+            .decode()
+            .with_context(|| format!("cannot decode texture {}", path.display()))?;
+        ensure!(
+            image.width() > 0 && image.height() > 0,
+            "texture {} is empty",
+            path.display()
+        );
+        Ok(Texture::from_image(path.to_path_buf(), kind, &image))
+    }
+
+    /// Converts a decoded, non-empty image for `kind` and builds its mips.
+    fn from_image(path: PathBuf, kind: TextureKind, image: &DynamicImage) -> Texture {
+        let (width, height) = (image.width(), image.height());
+        let level0 = match kind {
+            // Float images hold linear values; bytes of an albedo texture must be sRGB.
+            TextureKind::Albedo if is_float(image) => rgba32f_to_srgb8(image),
+            TextureKind::Albedo | TextureKind::Normal => image.to_rgba8().into_raw(),
+            TextureKind::Coverage => coverage(image),
+        };
+        Texture {
+            path,
             kind,
             width,
             height,
-            mips,
-        })
+            mips: mip_chain(kind, width, height, level0),
+        }
     }
 
     /// Bytes of all levels.
@@ -152,40 +72,271 @@ impl Texture {
     }
 }
 
+fn is_float(image: &DynamicImage) -> bool {
+    matches!(
+        image,
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+    )
+}
+
+fn rgba32f_to_srgb8(image: &DynamicImage) -> Vec<u8> {
+    image
+        .to_rgba32f()
+        .pixels()
+        .flat_map(|p| {
+            let [r, g, b, a] = p.0;
+            [srgb_encode(r), srgb_encode(g), srgb_encode(b), unorm8(a)]
+        })
+        .collect()
+}
+
+fn coverage(image: &DynamicImage) -> Vec<u8> {
+    let rgba = image.to_rgba8();
+    let use_alpha = image.color().has_alpha() && rgba.pixels().any(|p| p[3] < 255);
+    rgba.pixels()
+        .flat_map(|p| {
+            let c = if use_alpha {
+                p[3]
+            } else {
+                let [r, g, b, _] = p.0.map(f32::from);
+                (0.299 * r + 0.587 * g + 0.114 * b).round() as u8
+            };
+            [c; 4]
+        })
+        .collect()
+}
+
+/// sRGB byte to linear value: a table, as every texel of every albedo level-0 passes here.
+static SRGB_TO_LINEAR: LazyLock<[f32; 256]> = LazyLock::new(|| {
+    std::array::from_fn(|i| {
+        let c = i as f32 / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    })
+});
+
+/// Linear value to sRGB byte, computed exactly (a table indexed by the linear value would
+/// lose the dark end).
+fn srgb_encode(x: f32) -> u8 {
+    let x = x.clamp(0.0, 1.0);
+    let s = if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    };
+    unorm8(s)
+}
+
+fn unorm8(x: f32) -> u8 {
+    // NaN maps to 0 through the saturating cast.
+    (x.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+fn decode(kind: TextureKind, p: &[u8]) -> Vec4 {
+    match kind {
+        TextureKind::Albedo => Vec4::new(
+            SRGB_TO_LINEAR[p[0] as usize],
+            SRGB_TO_LINEAR[p[1] as usize],
+            SRGB_TO_LINEAR[p[2] as usize],
+            f32::from(p[3]) / 255.0,
+        ),
+        TextureKind::Coverage => unorm_vec4(p),
+        TextureKind::Normal => {
+            let v = unorm_vec4(p);
+            (v.truncate() * 2.0 - 1.0).extend(v.w)
+        }
+    }
+}
+
+fn unorm_vec4(p: &[u8]) -> Vec4 {
+    Vec4::from_array([p[0], p[1], p[2], p[3]].map(f32::from)) / 255.0
+}
+
+fn encode(kind: TextureKind, v: Vec4) -> [u8; 4] {
+    match kind {
+        TextureKind::Albedo => [
+            srgb_encode(v.x),
+            srgb_encode(v.y),
+            srgb_encode(v.z),
+            unorm8(v.w),
+        ],
+        TextureKind::Coverage => v.to_array().map(unorm8),
+        TextureKind::Normal => {
+            let n = v.truncate() * 0.5 + 0.5;
+            [unorm8(n.x), unorm8(n.y), unorm8(n.z), unorm8(v.w)]
+        }
+    }
+}
+
+/// Box-filters a `w` x `h` level (texel `i` from `fetch`) to `max(1, w / 2)` x
+/// `max(1, h / 2)`. Source coordinates are clamped, so a 1-texel axis averages with itself;
+/// on odd axes the last row or column is left out, keeping every texel a 2x2 average.
+fn halve(w: usize, h: usize, fetch: impl Fn(usize) -> Vec4) -> Vec<Vec4> {
+    let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+    let mut out = Vec::with_capacity(nw * nh);
+    for y in 0..nh {
+        let rows = [(2 * y).min(h - 1), (2 * y + 1).min(h - 1)];
+        for x in 0..nw {
+            let cols = [(2 * x).min(w - 1), (2 * x + 1).min(w - 1)];
+            let sum: Vec4 = rows
+                .iter()
+                .flat_map(|&r| cols.iter().map(move |&c| r * w + c))
+                .map(&fetch)
+                .sum();
+            out.push(sum * 0.25);
+        }
+    }
+    out
+}
+
+/// All levels of an RGBA8 image. Averages are carried in f32 from level to level, so
+/// rounding does not accumulate down the chain.
+fn mip_chain(kind: TextureKind, width: u32, height: u32, level0: Vec<u8>) -> Vec<Vec<u8>> {
+    let (mut w, mut h) = (width as usize, height as usize);
+    let mut mips = vec![level0];
+    let mut previous: Vec<Vec4> = Vec::new();
+    while w > 1 || h > 1 {
+        let mut next = if previous.is_empty() {
+            let texels = &mips[0];
+            halve(w, h, |i| decode(kind, &texels[4 * i..4 * i + 4]))
+        } else {
+            halve(w, h, |i| previous[i])
+        };
+        if kind == TextureKind::Normal {
+            // Averaged unit vectors are shorter than one; +Z (unperturbed) where they cancel.
+            for v in &mut next {
+                *v = v.truncate().normalize_or(Vec3::Z).extend(v.w);
+            }
+        }
+        mips.push(next.iter().flat_map(|&v| encode(kind, v)).collect());
+        (w, h) = ((w / 2).max(1), (h / 2).max(1));
+        previous = next;
+    }
+    mips
+}
+
 #[cfg(test)]
 mod tests {
+    use image::{Rgba, RgbaImage};
+
+    use super::super::testing::TempDir;
     use super::*;
 
-    fn write_png(name: &str, w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> PathBuf {
-        let path =
-            std::env::temp_dir().join(format!("voxcone-tex-{}-{name}.png", std::process::id()));
-        image::RgbaImage::from_fn(w, h, |x, y| image::Rgba(f(x, y)))
-            .save(&path)
-            .unwrap();
-        path
+    fn texture(kind: TextureKind, image: RgbaImage) -> Texture {
+        Texture::from_image(
+            PathBuf::from("test.png"),
+            kind,
+            &DynamicImage::ImageRgba8(image),
+        )
     }
 
     #[test]
     fn albedo_mips_average_in_linear_space() {
-        let path = write_png("checker", 4, 4, |x, y| {
+        let checker = RgbaImage::from_fn(4, 4, |x, y| {
             let v = if (x + y) % 2 == 0 { 255 } else { 0 };
-            [v, v, v, 255]
+            Rgba([v, v, v, 255])
         });
-        let t = Texture::load(&path, TextureKind::Albedo).unwrap();
-        std::fs::remove_file(&path).ok();
+        let t = texture(TextureKind::Albedo, checker);
         assert_eq!(t.mips.len(), 3);
-        // Linear 0.5 encodes to sRGB 188.
-        assert_eq!(t.mips[2][0], 188);
+        // Linear 0.5 is sRGB 0.7354, byte 188 (a gamma-space average would give 128).
+        assert_eq!(t.mips[1], [188, 188, 188, 255].repeat(4));
+        assert_eq!(t.mips[2], [188, 188, 188, 255]);
+    }
+
+    #[test]
+    fn srgb_round_trips_every_byte() {
+        for b in 0..=255u8 {
+            assert_eq!(srgb_encode(SRGB_TO_LINEAR[b as usize]), b);
+        }
+        assert_eq!(srgb_encode(f32::NAN), 0);
+        assert_eq!(srgb_encode(7.0), 255);
     }
 
     #[test]
     fn odd_sizes_give_full_chains() {
-        let path = write_png("odd", 5, 3, |_, _| [10, 20, 30, 255]);
-        let t = Texture::load(&path, TextureKind::Coverage).unwrap();
-        std::fs::remove_file(&path).ok();
+        let t = texture(
+            TextureKind::Coverage,
+            RgbaImage::from_pixel(5, 3, Rgba([10, 20, 30, 255])),
+        );
         let sizes: Vec<usize> = t.mips.iter().map(Vec::len).collect();
         assert_eq!(sizes, vec![5 * 3 * 4, 2 * 4, 4]);
-        // Opaque image: coverage comes from alpha.
-        assert_eq!(t.mips[0][0], 255);
+        let t = texture(TextureKind::Albedo, RgbaImage::new(1, 6));
+        let sizes: Vec<usize> = t.mips.iter().map(Vec::len).collect();
+        assert_eq!(sizes, vec![6 * 4, 3 * 4, 4]);
+    }
+
+    #[test]
+    fn coverage_from_alpha_else_luminance() {
+        let cut = RgbaImage::from_fn(2, 1, |x, _| {
+            Rgba([255, 255, 255, if x == 0 { 0 } else { 200 }])
+        });
+        let t = texture(TextureKind::Coverage, cut);
+        assert_eq!(t.mips[0], [0, 0, 0, 0, 200, 200, 200, 200]);
+        assert_eq!(t.mips[1], [100; 4], "linear average");
+        // Opaque alpha says nothing: the luminance is the mask.
+        let mask = RgbaImage::from_fn(2, 1, |x, _| {
+            if x == 0 {
+                Rgba([0, 0, 0, 255])
+            } else {
+                Rgba([0, 255, 0, 255])
+            }
+        });
+        let t = texture(TextureKind::Coverage, mask);
+        assert_eq!(t.mips[0], [0, 0, 0, 0, 150, 150, 150, 150]);
+        let grey = DynamicImage::ImageLuma8(image::GrayImage::from_pixel(1, 1, image::Luma([77])));
+        let t = Texture::from_image(PathBuf::new(), TextureKind::Coverage, &grey);
+        assert_eq!(t.mips[0], [77; 4]);
+    }
+
+    #[test]
+    fn normal_mips_are_renormalised() {
+        // +X and +Z side by side average to their bisector, not to a shorter vector.
+        let normals = RgbaImage::from_fn(2, 1, |x, _| {
+            if x == 0 {
+                Rgba([255, 128, 128, 255])
+            } else {
+                Rgba([128, 128, 255, 255])
+            }
+        });
+        let t = texture(TextureKind::Normal, normals);
+        let [x, y, z, a] = t.mips[1][..] else {
+            panic!("one texel")
+        };
+        let n = Vec3::new(x as f32, y as f32, z as f32) / 127.5 - 1.0;
+        assert!((n.length() - 1.0).abs() < 0.02, "{n}");
+        assert!((n.x - n.z).abs() < 0.02 && n.x > 0.69, "{n}");
+        assert_eq!(a, 255);
+    }
+
+    #[test]
+    fn float_albedo_is_encoded_to_srgb() {
+        let image = DynamicImage::ImageRgb32F(image::Rgb32FImage::from_pixel(
+            1,
+            1,
+            image::Rgb([0.5, 0.0, 1.0]),
+        ));
+        let t = Texture::from_image(PathBuf::new(), TextureKind::Albedo, &image);
+        assert_eq!(t.mips[0], [188, 0, 255, 255]);
+    }
+
+    #[test]
+    fn load_reads_files_and_names_bad_ones() {
+        let dir = TempDir::new("texture");
+        let path = dir.0.join("t.png");
+        RgbaImage::from_pixel(3, 2, Rgba([1, 2, 3, 4]))
+            .save(&path)
+            .unwrap();
+        let t = Texture::load(&path, TextureKind::Albedo).unwrap();
+        assert_eq!((t.width, t.height, t.mips.len()), (3, 2, 2));
+        assert_eq!(t.bytes(), 3 * 2 * 4 + 4);
+        let junk = dir.write("junk.png", "not an image");
+        let message = format!(
+            "{:#}",
+            Texture::load(&junk, TextureKind::Albedo).unwrap_err()
+        );
+        assert!(message.contains("junk.png"), "{message}");
     }
 }
