@@ -183,6 +183,7 @@ impl CommonArgs {
             exposure_ev: self.exposure,
             tonemap: self.tonemap,
             shadow_resolution: self.shadow_res,
+            cache_shadows: true,
         }
     }
 

@@ -43,6 +43,8 @@ pub struct RenderSettings {
     pub tonemap: Tonemap,
     /// Edge of each shadow map layer in texels.
     pub shadow_resolution: u32,
+    /// Keep the shadow maps while no light and no mesh moves.
+    pub cache_shadows: bool,
 }
 
 impl Default for RenderSettings {
@@ -53,6 +55,7 @@ impl Default for RenderSettings {
             exposure_ev: 0.0,
             tonemap: Tonemap::Clamp,
             shadow_resolution: 1024,
+            cache_shadows: true,
         }
     }
 }
@@ -96,6 +99,8 @@ pub struct Renderer {
     lighting: LightingPass,
     gbuffer_pass: GBufferPass,
     shadow: ShadowPass,
+    /// Light views and mesh transforms the shadow maps were last rendered with.
+    shadow_inputs: Option<Vec<[[f32; 4]; 4]>>,
     frames: Vec<FrameData>,
     /// Owns the frame descriptor sets.
     _frame_sets: DescriptorSets,
@@ -247,6 +252,7 @@ impl Renderer {
             lighting,
             gbuffer_pass,
             shadow,
+            shadow_inputs: None,
             frames,
             _frame_sets: frame_sets,
             ring: FrameRing::new(ctx, FRAMES_IN_FLIGHT)?,
@@ -408,9 +414,20 @@ impl Renderer {
         let timer = &mut data.timer;
         timer.reset(cmd);
 
-        timer.begin(cmd, "shadow");
-        self.shadow.record(&ctx, cmd, &draw, &views);
-        timer.end(cmd);
+        let inputs: Vec<[[f32; 4]; 4]> = views
+            .iter()
+            .map(|v| v.view_proj)
+            .chain(
+                (0..self.scene.meshes.len())
+                    .map(|m| self.scene.mesh_transform(m, time_s).to_cols_array_2d()),
+            )
+            .collect();
+        if !(self.settings.cache_shadows && self.shadow_inputs.as_ref() == Some(&inputs)) {
+            timer.begin(cmd, "shadow");
+            self.shadow.record(&ctx, cmd, &draw, &views);
+            timer.end(cmd);
+            self.shadow_inputs = Some(inputs);
+        }
 
         timer.begin(cmd, "gbuffer");
         self.gbuffer_pass
