@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use crate::renderer::{RenderSettings, Tonemap};
+use crate::gi::ConeSettings;
+use crate::renderer::{GiSettings, RenderSettings, Tonemap};
 use crate::scene::LoadOptions;
 
 #[derive(Parser, Debug)]
@@ -37,6 +38,8 @@ pub enum GiMode {
     /// Direct light only.
     #[default]
     Off,
+    /// Voxel cone tracing on a dense voxel grid in 3D textures.
+    Dense,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -69,6 +72,12 @@ pub struct CommonArgs {
     /// Shadow map resolution per light view.
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub shadow_res: u32,
+    /// Voxels per axis of the dense grid (a power of two).
+    #[arg(long, default_value_t = 64)]
+    pub voxels: u32,
+    /// Light bounces between voxels (1: direct light on the voxels only).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
+    pub bounces: u32,
     /// Scene time in seconds (animation).
     #[arg(long, default_value_t = 0.0)]
     pub time: f32,
@@ -184,6 +193,13 @@ impl CommonArgs {
             tonemap: self.tonemap,
             shadow_resolution: self.shadow_res,
             cache_shadows: true,
+            gi: (self.gi == GiMode::Dense).then_some(GiSettings {
+                voxels: self.voxels,
+                cones: ConeSettings {
+                    bounces: self.bounces,
+                    ..ConeSettings::default()
+                },
+            }),
         }
     }
 

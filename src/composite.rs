@@ -37,6 +37,7 @@ impl CompositePass {
             &GraphicsDesc {
                 name: "composite",
                 vertex: crate::vk::shaders::COMPOSITE_FULLSCREEN_VERT,
+                geometry: None,
                 fragment: Some(crate::vk::shaders::COMPOSITE_COMPOSITE_FRAG),
                 vertex_stride: 0,
                 attributes: &[],

@@ -76,6 +76,7 @@ impl GBufferPass {
             &GraphicsDesc {
                 name: "gbuffer",
                 vertex: crate::vk::shaders::GBUFFER_GBUFFER_VERT,
+                geometry: None,
                 fragment: Some(crate::vk::shaders::GBUFFER_GBUFFER_FRAG),
                 vertex_stride: std::mem::size_of::<crate::scene::Vertex>() as u32,
                 attributes: &VERTEX_ATTRIBUTES,
@@ -153,7 +154,7 @@ impl GBufferPass {
             .depth_attachment(&depth);
         unsafe { ctx.device.cmd_begin_rendering(cmd, &rendering) };
         set_viewport(ctx, cmd, extent);
-        draw.draw_meshes(ctx, cmd, &self.pipeline, 0);
+        draw.draw_meshes(ctx, cmd, &self.pipeline, 0, None);
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         for image in target.colors() {
             image_barrier(

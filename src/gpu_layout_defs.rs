@@ -44,6 +44,39 @@ gpu_layout! {
         /// composite pass (set 2): HDR radiance in, `sampler2D`.
         BINDING_COMPOSITE_HDR = 0;
 
+        /// GI passes (set 2): `GiUniforms` uniform buffer.
+        BINDING_GI_UNIFORMS = 0;
+        /// GI passes (set 2): voxel albedo, RGBA8 moving average packed in `r32ui`.
+        BINDING_GI_ALBEDO = 1;
+        /// GI passes (set 2): voxel normal (xyz * 0.5 + 0.5), RGBA8 moving average in `r32ui`.
+        BINDING_GI_NORMAL = 2;
+        /// GI passes (set 2): voxel emission / `GiUniforms.emission_range`, RGBA8 in `r32ui`.
+        BINDING_GI_EMISSION = 3;
+        /// GI passes (set 2): voxel radiance, premultiplied by opacity, `rgba16f` storage.
+        BINDING_GI_RADIANCE = 4;
+        /// GI passes (set 2): voxel radiance, `sampler3D`.
+        BINDING_GI_RADIANCE_SAMPLED = 5;
+        /// GI passes (set 2): the six directional mip volumes, `sampler3D[6]`.
+        BINDING_GI_DIRECTIONAL = 6;
+        /// GI passes (set 2): screen radiance, read and added to, `rgba32f` storage.
+        BINDING_GI_SCREEN = 7;
+        /// GI passes (set 2): G-buffer albedo, `rgba16f` storage.
+        BINDING_GI_GBUFFER_ALBEDO = 8;
+        /// GI passes (set 2): G-buffer normal, `rgba16f` storage.
+        BINDING_GI_GBUFFER_NORMAL = 9;
+        /// GI passes (set 2): G-buffer depth, `sampler2D`.
+        BINDING_GI_GBUFFER_DEPTH = 10;
+        /// GI passes (set 2): voxel direct radiance (before bounces), `rgba16f` storage.
+        BINDING_GI_DIRECT = 11;
+        /// filter pass (set 2): the level read, `rgba16f` storage `[6]` (+X -X +Y -Y +Z -Z).
+        BINDING_FILTER_SRC = 0;
+        /// filter pass (set 2): the level written, `rgba16f` storage `[6]`.
+        BINDING_FILTER_DST = 1;
+        /// Workgroup edge of the 3D compute passes.
+        VOXEL_GROUP_SIZE = 4;
+        /// Cones of the diffuse gather.
+        DIFFUSE_CONES = 6;
+
         /// `GpuLight.kind`: point light, intensity in W/sr.
         LIGHT_POINT = 0;
         /// `GpuLight.kind`: spot light, intensity in W/sr on its axis.
@@ -134,6 +167,28 @@ gpu_layout! {
         uint normal_texture,
         /// Unused, keeps the struct a multiple of 16 bytes.
         uint pad,
+    }
+
+    /// The dense voxel grid and cone-tracing settings.
+    struct GiUniforms {
+        /// xyz world position of the grid's minimum corner, w voxel size.
+        vec4 origin,
+        /// Voxels per axis.
+        uint resolution,
+        /// Mip levels of the directional volumes (resolution / 2 down to 1).
+        uint directional_levels,
+        /// Emission is stored divided by this (the scene's largest emitted radiance).
+        float emission_range,
+        /// Cone step as a fraction of the cone diameter.
+        float step_factor,
+        /// tan of half the diffuse cone aperture.
+        float diffuse_tan_half,
+        /// Cones stop after this distance in world units.
+        float max_distance,
+        /// Unused.
+        float pad0,
+        /// Unused.
+        float pad1,
     }
 
     /// Push constants of every mesh draw.

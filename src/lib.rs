@@ -8,6 +8,7 @@ pub mod compare;
 pub mod composite;
 pub mod frontend;
 pub mod gbuffer;
+pub mod gi;
 pub mod gpu_layout;
 pub mod imageio;
 pub mod lighting;

@@ -11,6 +11,7 @@ use gpu_allocator::MemoryLocation;
 
 use crate::composite::CompositePass;
 use crate::gbuffer::{GBuffer, GBufferPass};
+use crate::gi::{ConeSettings, DenseGi};
 use crate::gpu_layout::{self as layout, FrameUniforms, GpuLight, ShadowView};
 use crate::lighting::LightingPass;
 use crate::scene::{Camera, LightKind, Scene};
@@ -31,6 +32,14 @@ pub enum Tonemap {
     Aces,
 }
 
+/// Global illumination on a dense voxel grid.
+#[derive(Clone, Copy, Debug)]
+pub struct GiSettings {
+    /// Voxels per axis (a power of two).
+    pub voxels: u32,
+    pub cones: ConeSettings,
+}
+
 /// Settings that change what a frame computes.
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
@@ -45,6 +54,8 @@ pub struct RenderSettings {
     pub shadow_resolution: u32,
     /// Keep the shadow maps while no light and no mesh moves.
     pub cache_shadows: bool,
+    /// Indirect light; `None` for direct light only.
+    pub gi: Option<GiSettings>,
 }
 
 impl Default for RenderSettings {
@@ -56,6 +67,7 @@ impl Default for RenderSettings {
             tonemap: Tonemap::Clamp,
             shadow_resolution: 1024,
             cache_shadows: true,
+            gi: None,
         }
     }
 }
@@ -99,6 +111,7 @@ pub struct Renderer {
     lighting: LightingPass,
     gbuffer_pass: GBufferPass,
     shadow: ShadowPass,
+    gi: Option<DenseGi>,
     /// Light views and mesh transforms the shadow maps were last rendered with.
     shadow_inputs: Option<Vec<[[f32; 4]; 4]>>,
     frames: Vec<FrameData>,
@@ -156,6 +169,10 @@ impl Renderer {
         let gbuffer_pass = GBufferPass::new(ctx, &set_layouts)?;
         let lighting = LightingPass::new(ctx, set_layouts)?;
         let composite = CompositePass::new(ctx, set_layouts, output_format)?;
+        let gi = settings
+            .gi
+            .map(|g| DenseGi::new(ctx, &scene, g.voxels, g.cones, set_layouts))
+            .transpose()?;
         let nearest_sampler = Sampler::new(
             ctx,
             "nearest",
@@ -252,6 +269,7 @@ impl Renderer {
             lighting,
             gbuffer_pass,
             shadow,
+            gi,
             shadow_inputs: None,
             frames,
             _frame_sets: frame_sets,
@@ -278,6 +296,9 @@ impl Renderer {
             .bind_targets(&self.ctx, &t.gbuffer, &t.radiance, self.nearest_sampler.raw);
         self.composite
             .bind_input(&self.ctx, &t.radiance, self.nearest_sampler.raw);
+        if let Some(gi) = &self.gi {
+            gi.bind_screen(&t.gbuffer, &t.radiance, self.nearest_sampler.raw);
+        }
     }
 
     pub fn context(&self) -> &Arc<Context> {
@@ -286,6 +307,13 @@ impl Renderer {
 
     pub fn extent(&self) -> vk::Extent2D {
         self.targets.gbuffer.extent()
+    }
+
+    /// GPU memory of the voxel volumes, by name (empty without GI).
+    pub fn gi_memory_bytes(&self) -> Vec<(&'static str, u64)> {
+        self.gi
+            .as_ref()
+            .map_or_else(Vec::new, DenseGi::memory_bytes)
     }
 
     /// Bytes of GPU memory held by scene textures.
@@ -397,6 +425,7 @@ impl Renderer {
         let lights = self.gpu_lights(time_s);
         let views: Vec<ShadowView> =
             shadow::scene_views(&self.scene, time_s, self.settings.shadow_resolution);
+        let extent = self.extent();
         let data = &mut self.frames[frame.slot];
         data.uniforms.write(0, bytemuck::bytes_of(&uniforms));
         data.lights.write(0, bytemuck::cast_slice(&lights));
@@ -434,6 +463,10 @@ impl Renderer {
             .record(&ctx, cmd, &self.targets.gbuffer, &draw);
         timer.end(cmd);
 
+        if let Some(gi) = &self.gi {
+            gi.record_update(cmd, timer, &draw);
+        }
+
         timer.begin(cmd, "lighting");
         self.lighting.record(
             &ctx,
@@ -443,6 +476,9 @@ impl Renderer {
             self.radiance_last_use,
         );
         timer.end(cmd);
+        if let Some(gi) = &self.gi {
+            gi.record_gather(cmd, timer, data.set, extent);
+        }
 
         timer.begin(cmd, "composite");
         image_barrier(

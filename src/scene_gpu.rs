@@ -25,14 +25,19 @@ pub struct SceneDraw<'a> {
 impl SceneDraw<'_> {
     /// Binds `pipeline` and the geometry, then draws every mesh with its model matrix
     /// and material in the push constants; `shadow_view` selects the shadow view.
+    /// `pass_set` is bound as set 2 when given.
     pub fn draw_meshes(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         pipeline: &Pipeline,
         shadow_view: u32,
+        pass_set: Option<vk::DescriptorSet>,
     ) {
         pipeline.bind(cmd, &self.sets);
+        if let Some(set) = pass_set {
+            pipeline.bind_set(cmd, layout::SET_PASS, set);
+        }
         self.gpu.bind_geometry(ctx, cmd);
         for draw in &self.gpu.draws {
             let push = DrawPush {

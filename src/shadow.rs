@@ -153,6 +153,7 @@ impl ShadowPass {
             &GraphicsDesc {
                 name: "shadow",
                 vertex: crate::vk::shaders::SHADOW_SHADOW_VERT,
+                geometry: None,
                 fragment: Some(crate::vk::shaders::SHADOW_SHADOW_FRAG),
                 vertex_stride: std::mem::size_of::<crate::scene::Vertex>() as u32,
                 // Position and uv (for cut-outs); the shadow pass has no use for normals.
@@ -221,7 +222,7 @@ impl ShadowPass {
             // Slope-scaled bias removes acne on surfaces at grazing angles to the light;
             // the lighting pass adds a normal offset for the rest.
             unsafe { ctx.device.cmd_set_depth_bias(cmd, 0.0, 0.0, 1.5) };
-            draw.draw_meshes(ctx, cmd, &self.pipeline, index as u32);
+            draw.draw_meshes(ctx, cmd, &self.pipeline, index as u32, None);
             unsafe { ctx.device.cmd_end_rendering(cmd) };
         }
         image_barrier(

@@ -25,7 +25,9 @@ uint shadow_view_for(GpuLight light, vec3 p) {
 }
 
 // Fraction of the light reaching p (normal n), 5x5 PCF over bilinear depth compares.
-float shadow_visibility(GpuLight light, vec3 p, vec3 n) {
+// `extra_offset` moves p further along n (voxel centres lie up to half a voxel inside
+// their surface).
+float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset) {
     if (light.shadow_view_count == 0u) {
         return 1.0;
     }
@@ -34,7 +36,7 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n) {
     // Normal offset of about two texels at p's distance keeps a surface from shadowing
     // itself without the light leaking through thin walls.
     float texel_world = ortho ? view.texel_size : view.texel_size * distance(p, view.origin.xyz);
-    vec4 clip = view.view_proj * vec4(p + n * (2.0 * texel_world), 1.0);
+    vec4 clip = view.view_proj * vec4(p + n * (2.0 * texel_world + extra_offset), 1.0);
     vec3 ndc = clip.xyz / clip.w;
     vec2 uv = ndc.xy * 0.5 + 0.5;
     vec2 texel_uv = 1.0 / vec2(textureSize(shadow_map, 0).xy);
@@ -48,7 +50,7 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n) {
 }
 
 // Irradiance at p (normal n) from one light, shadowed, and the unit vector towards it.
-vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, out vec3 to_light) {
+vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, float extra_offset, out vec3 to_light) {
     vec3 e;
     if (light.kind == LIGHT_DIRECTIONAL) {
         to_light = -light.direction.xyz;
@@ -67,6 +69,6 @@ vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, out vec3 to_light) {
     if (cos_theta <= 0.0) {
         return vec3(0.0);
     }
-    return e * cos_theta * shadow_visibility(light, p, n);
+    return e * cos_theta * shadow_visibility(light, p, n, extra_offset);
 }
 #endif

@@ -37,7 +37,7 @@ void main() {
     vec3 radiance = imageLoad(gbuffer_emission, pixel).rgb;
     for (uint i = 0u; i < frame.light_count; i++) {
         vec3 l;
-        vec3 e = light_irradiance(lights[i], p, n, l);
+        vec3 e = light_irradiance(lights[i], p, n, 0.0, l);
         if (all(equal(e, vec3(0.0)))) {
             continue;
         }

@@ -111,6 +111,9 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
     let mib = |bytes: u64| bytes as f64 / (1024.0 * 1024.0);
     let mut memory_mib = BTreeMap::new();
     memory_mib.insert("scene_textures".to_string(), mib(renderer.texture_bytes()));
+    for (name, bytes) in renderer.gi_memory_bytes() {
+        memory_mib.insert(name.to_string(), mib(bytes));
+    }
     let mut stats_map = BTreeMap::new();
     stats_map.insert("triangles".to_string(), triangles as f64);
     let report = BenchReport {

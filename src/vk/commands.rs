@@ -80,11 +80,10 @@ impl ImageUse {
         stage: vk::PipelineStageFlags2::COPY,
         access: vk::AccessFlags2::TRANSFER_READ,
     };
+    /// Copies, blits and clears.
     pub const TRANSFER_DST: Self = Self {
         layout: vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-        stage: vk::PipelineStageFlags2::from_raw(
-            vk::PipelineStageFlags2::COPY.as_raw() | vk::PipelineStageFlags2::BLIT.as_raw(),
-        ),
+        stage: vk::PipelineStageFlags2::ALL_TRANSFER,
         access: vk::AccessFlags2::TRANSFER_WRITE,
     };
     /// The layout transition must be in a stage the frame's semaphore signal (stage

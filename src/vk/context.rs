@@ -228,6 +228,14 @@ impl Context {
             .depth_clamp(features.depth_clamp)
             .shader_storage_image_write_without_format(
                 supported.shader_storage_image_write_without_format == vk::TRUE,
+            )
+            // Descriptor arrays indexed by a uniform, non-constant value (material
+            // textures, the six directional volumes).
+            .shader_sampled_image_array_dynamic_indexing(
+                supported.shader_sampled_image_array_dynamic_indexing == vk::TRUE,
+            )
+            .shader_storage_image_array_dynamic_indexing(
+                supported.shader_storage_image_array_dynamic_indexing == vk::TRUE,
             );
         let mut vk12 = vk::PhysicalDeviceVulkan12Features::default().timeline_semaphore(true);
         let mut vk13 = vk::PhysicalDeviceVulkan13Features::default()

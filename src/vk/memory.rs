@@ -113,6 +113,22 @@ pub struct ImageDesc {
 }
 
 impl ImageDesc {
+    /// A cubic 3D image of edge `n` with `mip_levels` levels.
+    pub fn d3(format: vk::Format, n: u32, mip_levels: u32, usage: vk::ImageUsageFlags) -> Self {
+        Self {
+            format,
+            extent: vk::Extent3D {
+                width: n,
+                height: n,
+                depth: n,
+            },
+            image_type: vk::ImageType::TYPE_3D,
+            mip_levels,
+            layers: 1,
+            usage,
+        }
+    }
+
     pub fn d2(format: vk::Format, width: u32, height: u32, usage: vk::ImageUsageFlags) -> Self {
         Self {
             format,
@@ -219,11 +235,17 @@ impl Image {
         })
     }
 
-    /// A view of one layer and one mip level (render target of a layered image).
+    /// A view of one layer and one mip level (a render target of a layered image, or one
+    /// level of a 3D image).
     pub fn layer_view(&self, layer: u32, level: u32) -> Result<OwnedView> {
+        let view_type = if self.desc.image_type == vk::ImageType::TYPE_3D {
+            vk::ImageViewType::TYPE_3D
+        } else {
+            vk::ImageViewType::TYPE_2D
+        };
         let info = vk::ImageViewCreateInfo::default()
             .image(self.raw)
-            .view_type(vk::ImageViewType::TYPE_2D)
+            .view_type(view_type)
             .format(self.desc.format)
             .subresource_range(vk::ImageSubresourceRange {
                 aspect_mask: self.aspect,

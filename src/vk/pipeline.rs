@@ -100,6 +100,20 @@ impl Pipeline {
         }
     }
 
+    /// Binds one more descriptor set to the bound pipeline.
+    pub fn bind_set(&self, cmd: vk::CommandBuffer, index: u32, set: vk::DescriptorSet) {
+        unsafe {
+            self.ctx.device.cmd_bind_descriptor_sets(
+                cmd,
+                self.bind_point,
+                self.layout,
+                index,
+                &[set],
+                &[],
+            )
+        };
+    }
+
     pub fn push<T: bytemuck::Pod>(
         &self,
         cmd: vk::CommandBuffer,
@@ -131,6 +145,7 @@ impl Drop for Pipeline {
 pub struct GraphicsDesc<'a> {
     pub name: &'a str,
     pub vertex: &'a [u8],
+    pub geometry: Option<&'a [u8]>,
     pub fragment: Option<&'a [u8]>,
     /// Vertex stride and (location, format, offset) attributes; empty for a full-screen triangle.
     pub vertex_stride: u32,
@@ -150,6 +165,10 @@ impl Pipeline {
         let push_stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let layout = pipeline_layout(ctx, desc.set_layouts, desc.push_constant_bytes, push_stages)?;
         let vertex = shader_module(ctx, desc.vertex, desc.name)?;
+        let geometry = desc
+            .geometry
+            .map(|g| shader_module(ctx, g, desc.name))
+            .transpose()?;
         let fragment = desc
             .fragment
             .map(|f| shader_module(ctx, f, desc.name))
@@ -158,6 +177,14 @@ impl Pipeline {
             .stage(vk::ShaderStageFlags::VERTEX)
             .module(vertex)
             .name(c"main")];
+        if let Some(geometry) = geometry {
+            stages.push(
+                vk::PipelineShaderStageCreateInfo::default()
+                    .stage(vk::ShaderStageFlags::GEOMETRY)
+                    .module(geometry)
+                    .name(c"main"),
+            );
+        }
         if let Some(fragment) = fragment {
             stages.push(
                 vk::PipelineShaderStageCreateInfo::default()
@@ -243,6 +270,9 @@ impl Pipeline {
         };
         unsafe {
             ctx.device.destroy_shader_module(vertex, None);
+            if let Some(geometry) = geometry {
+                ctx.device.destroy_shader_module(geometry, None);
+            }
             if let Some(fragment) = fragment {
                 ctx.device.destroy_shader_module(fragment, None);
             }

@@ -1,0 +1,70 @@
+// Cone marching through the voxel radiance (Crassin et al. 2011), shared by the screen
+// gather and the voxel bounce.
+#ifndef CONES_GLSL
+#define CONES_GLSL
+#include "common/frame.glsl"
+#include "gi/voxels.glsl"
+
+layout(set = SET_PASS, binding = BINDING_GI_RADIANCE_SAMPLED) uniform sampler3D voxel_radiance;
+layout(set = SET_PASS, binding = BINDING_GI_DIRECTIONAL) uniform sampler3D voxel_directional[6];
+
+// Voxel radiance at `uvw` for a cone travelling along `dir` with footprint `lod` (0 = one
+// voxel): the base level below lod 1, blended into the three directional volumes facing
+// the cone, weighted by the squared direction components.
+vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
+    vec4 base = textureLod(voxel_radiance, uvw, 0.0);
+    if (lod <= 0.0) {
+        return base;
+    }
+    vec3 w = dir * dir;
+    float level = max(lod - 1.0, 0.0);
+    vec4 aniso = w.x * textureLod(voxel_directional[dir.x >= 0.0 ? 0 : 1], uvw, level)
+        + w.y * textureLod(voxel_directional[dir.y >= 0.0 ? 2 : 3], uvw, level)
+        + w.z * textureLod(voxel_directional[dir.z >= 0.0 ? 4 : 5], uvw, level);
+    return lod < 1.0 ? mix(base, aniso, lod) : aniso;
+}
+
+// Front-to-back accumulation along one cone; returns premultiplied radiance (rgb) and
+// occlusion (a), with the sky behind whatever the cone leaves open.
+vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod) {
+    float voxel = gi.origin.w;
+    float grid_size = voxel * float(gi.resolution);
+    vec4 acc = vec4(0.0);
+    float dist = voxel;
+    while (acc.a < 0.99 && dist < gi.max_distance) {
+        float diameter = max(voxel, 2.0 * tan_half * dist);
+        float lod = max(log2(diameter / voxel), min_lod);
+        vec3 uvw = (origin + dir * dist - gi.origin.xyz) / grid_size;
+        if (any(lessThan(uvw, vec3(0.0))) || any(greaterThan(uvw, vec3(1.0)))) {
+            break;
+        }
+        vec4 s = sample_voxels(uvw, dir, lod);
+        float step_length = diameter * gi.step_factor;
+        // Opacity was filtered for a step of one sample diameter; correct it to this step.
+        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), step_length / diameter);
+        vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
+        acc.rgb += (1.0 - acc.a) * rgb;
+        acc.a += (1.0 - acc.a) * a;
+        dist += step_length;
+    }
+    acc.rgb += (1.0 - acc.a) * frame.sky_radiance.rgb;
+    return acc;
+}
+
+
+// Cosine-weighted mean radiance over the hemisphere around n from six 60-degree cones:
+// one along n, five around it at 60 degrees.
+vec3 gather_diffuse(vec3 origin, vec3 n, float min_lod) {
+    vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
+    vec3 b = cross(n, t);
+    vec3 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod).rgb;
+    float weight = 1.0;
+    for (int i = 0; i < DIFFUSE_CONES - 1; i++) {
+        float phi = 6.2831853 * float(i) / float(DIFFUSE_CONES - 1);
+        vec3 dir = normalize(0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b));
+        sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod).rgb * 0.5;
+        weight += 0.5;
+    }
+    return sum / weight;
+}
+#endif

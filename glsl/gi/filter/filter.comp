@@ -1,0 +1,40 @@
+#version 460
+// One level of the anisotropic mip chain (Crassin 2011; Dřínovský 2013 §5.5): for each
+// direction a cone can travel (+X -X +Y -Y +Z -Z), the 2x2x2 children are composited
+// front to back along that axis in pairs and the four pairs averaged. Values are
+// premultiplied by opacity. The first level reads the isotropic base in all six slots.
+#include "gpu_layout.glsl"
+
+layout(local_size_x = VOXEL_GROUP_SIZE, local_size_y = VOXEL_GROUP_SIZE, local_size_z = VOXEL_GROUP_SIZE) in;
+layout(set = SET_PASS, binding = BINDING_FILTER_SRC, rgba16f) uniform readonly image3D src[6];
+layout(set = SET_PASS, binding = BINDING_FILTER_DST, rgba16f) uniform writeonly image3D dst[6];
+
+vec4 over(vec4 front, vec4 back) {
+    return front + (1.0 - front.a) * back;
+}
+
+void main() {
+    ivec3 parent = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(parent, imageSize(dst[0])))) {
+        return;
+    }
+    ivec3 base = parent * 2;
+    for (int d = 0; d < 6; d++) {
+        int axis = d / 2;
+        // Travelling along +axis meets the child at offset 0 first.
+        int front = (d % 2 == 0) ? 0 : 1;
+        vec4 sum = vec4(0.0);
+        for (int u = 0; u < 2; u++) {
+            for (int v = 0; v < 2; v++) {
+                ivec3 f = ivec3(0);
+                f[(axis + 1) % 3] = u;
+                f[(axis + 2) % 3] = v;
+                ivec3 b = f;
+                f[axis] = front;
+                b[axis] = 1 - front;
+                sum += over(imageLoad(src[d], base + f), imageLoad(src[d], base + b));
+            }
+        }
+        imageStore(dst[d], parent, sum * 0.25);
+    }
+}

@@ -1,0 +1,24 @@
+// Set 2 of the GI passes: the dense voxel grid (Präntare 2016; Villegas 2018).
+#ifndef VOXELS_GLSL
+#define VOXELS_GLSL
+#include "gpu_layout.glsl"
+
+layout(set = SET_PASS, binding = BINDING_GI_UNIFORMS) uniform GiBlock {
+    GiUniforms gi;
+};
+
+// RGBA8 packed as r | g << 8 | b << 16 | a << 24, channels in 0..255.
+vec4 unpack_rgba8(uint v) {
+    return vec4(float(v & 0xffu), float((v >> 8) & 0xffu), float((v >> 16) & 0xffu), float(v >> 24));
+}
+
+uint pack_rgba8(vec4 v) {
+    uvec4 u = uvec4(clamp(round(v), 0.0, 255.0));
+    return u.x | (u.y << 8) | (u.z << 16) | (u.w << 24);
+}
+
+// World position of the centre of voxel `v`.
+vec3 voxel_center(ivec3 v) {
+    return gi.origin.xyz + (vec3(v) + 0.5) * gi.origin.w;
+}
+#endif

@@ -1,0 +1,49 @@
+//! Cone tracing: indirect diffuse light per G-buffer pixel, added to the direct light.
+
+use std::sync::Arc;
+
+use anyhow::Result;
+use ash::vk;
+
+use crate::gpu_layout as layout;
+use crate::vk::{groups, Context, Pipeline};
+
+pub struct ConeTracePass {
+    pipeline: Pipeline,
+}
+
+impl ConeTracePass {
+    /// `set_layouts` are those of sets 0, 1 and 2.
+    pub fn new(ctx: &Arc<Context>, set_layouts: [vk::DescriptorSetLayout; 3]) -> Result<Self> {
+        let pipeline = Pipeline::compute(
+            ctx,
+            "cone_trace",
+            crate::vk::shaders::GI_CONE_TRACE_CONE_TRACE_COMP,
+            &set_layouts,
+            0,
+        )?;
+        Ok(Self { pipeline })
+    }
+
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        frame_set: vk::DescriptorSet,
+        gi_set: vk::DescriptorSet,
+        extent: vk::Extent2D,
+    ) {
+        self.pipeline.bind(
+            cmd,
+            &[(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)],
+        );
+        unsafe {
+            ctx.device.cmd_dispatch(
+                cmd,
+                groups(extent.width, layout::SCREEN_GROUP_SIZE),
+                groups(extent.height, layout::SCREEN_GROUP_SIZE),
+                1,
+            )
+        };
+    }
+}

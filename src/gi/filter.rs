@@ -1,0 +1,96 @@
+//! Anisotropic filtering: the six directional mip chains of the voxel radiance, one
+//! compute dispatch per level.
+
+use std::sync::Arc;
+
+use anyhow::Result;
+use ash::vk;
+
+use super::{compute_to_compute, Volumes};
+use crate::gpu_layout as layout;
+use crate::vk::{groups, Binding, Context, DescriptorSets, OwnedView, Pipeline, SetWriter};
+
+pub struct FilterPass {
+    pipeline: Pipeline,
+    /// One set per level: level 0 reads the base volume, level k the directional level k-1.
+    level_sets: Vec<vk::DescriptorSet>,
+    _sets: DescriptorSets,
+    /// Per-level views of the directional volumes, referenced by the sets.
+    _views: Vec<OwnedView>,
+}
+
+impl FilterPass {
+    /// `set_layouts` are those of sets 0 and 1 (unused, but set 2 sits after them).
+    pub(super) fn new(
+        ctx: &Arc<Context>,
+        set_layouts: [vk::DescriptorSetLayout; 2],
+        volumes: &Volumes,
+    ) -> Result<Self> {
+        let storage = vk::DescriptorType::STORAGE_IMAGE;
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let bindings = [
+            Binding::new(layout::BINDING_FILTER_SRC, storage, compute).array(6),
+            Binding::new(layout::BINDING_FILTER_DST, storage, compute).array(6),
+        ];
+        let levels = volumes.directional[0].desc.mip_levels;
+        let sets = DescriptorSets::new(ctx, "filter", &bindings, levels)?;
+        let pipeline = Pipeline::compute(
+            ctx,
+            "filter",
+            crate::vk::shaders::GI_FILTER_FILTER_COMP,
+            &[set_layouts[0], set_layouts[1], sets.layout],
+            0,
+        )?;
+        let mut views = Vec::new();
+        for level in 0..levels {
+            for image in &volumes.directional {
+                views.push(image.layer_view(0, level)?);
+            }
+        }
+        let info = |view: vk::ImageView| vk::DescriptorImageInfo {
+            sampler: vk::Sampler::null(),
+            image_view: view,
+            image_layout: vk::ImageLayout::GENERAL,
+        };
+        let mut level_sets = Vec::new();
+        for level in 0..levels as usize {
+            let set = sets.allocate(&format!("filter level {level}"))?;
+            let src: Vec<_> = if level == 0 {
+                vec![info(volumes.radiance.view); 6]
+            } else {
+                views[(level - 1) * 6..level * 6]
+                    .iter()
+                    .map(|v| info(v.raw))
+                    .collect()
+            };
+            let dst = views[level * 6..(level + 1) * 6]
+                .iter()
+                .map(|v| info(v.raw))
+                .collect();
+            SetWriter::new(ctx, set)
+                .images(layout::BINDING_FILTER_SRC, storage, src)
+                .images(layout::BINDING_FILTER_DST, storage, dst)
+                .apply();
+            level_sets.push(set);
+        }
+        Ok(Self {
+            pipeline,
+            level_sets,
+            _sets: sets,
+            _views: views,
+        })
+    }
+
+    /// Builds every level from the base radiance (written before this, barrier included).
+    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer, n: u32) {
+        for (level, &set) in self.level_sets.iter().enumerate() {
+            if level > 0 {
+                compute_to_compute(ctx, cmd);
+            }
+            self.pipeline.bind(cmd, &[(layout::SET_PASS, set)]);
+            let size = (n >> (level + 1)).max(1);
+            let g = groups(size, layout::VOXEL_GROUP_SIZE);
+            unsafe { ctx.device.cmd_dispatch(cmd, g, g, g) };
+        }
+    }
+}

@@ -1,0 +1,436 @@
+//! Global illumination on a dense voxel grid held in 3D textures (`--gi dense`), as in
+//! Präntare (2016) and Villegas (2018), traced with cones as in Crassin et al. (2011).
+//!
+//! Per frame: voxelize (clear + rasterize into packed RGBA8 averages) -> inject (voxel
+//! shading) -> filter (anisotropic mips) -> cone trace (after the direct lighting).
+
+mod cone_trace;
+mod filter;
+mod inject;
+mod voxelize;
+
+use std::sync::Arc;
+
+use anyhow::{bail, Result};
+use ash::vk;
+use glam::Vec3;
+
+use crate::gbuffer::GBuffer;
+use crate::gpu_layout::{self as layout, GiUniforms};
+use crate::scene::Scene;
+use crate::scene_gpu::SceneDraw;
+use crate::vk::{
+    image_barrier, memory_barrier, Binding, Buffer, Context, DescriptorSets, GpuTimer, Image,
+    ImageDesc, ImageUse, OneShot, Sampler, SetWriter,
+};
+
+/// The cube the voxels tile: voxel (i, j, k) covers origin + [i, i+1) x [j, j+1) x [k, k+1)
+/// times `voxel_size`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid {
+    pub origin: Vec3,
+    pub voxel_size: f32,
+    pub resolution: u32,
+}
+
+impl Grid {
+    /// A cube around the scene's bounds at time 0, with a little room so that surfaces
+    /// on the bounds are not cut by the grid's edge.
+    pub fn around(scene: &Scene, resolution: u32) -> Self {
+        let bounds = scene.bounds(0.0);
+        let size = (bounds.max - bounds.min).max_element().max(1e-3) * 1.04;
+        Self {
+            origin: bounds.center() - Vec3::splat(size * 0.5),
+            voxel_size: size / resolution as f32,
+            resolution,
+        }
+    }
+}
+
+/// Cone settings.
+#[derive(Clone, Copy, Debug)]
+pub struct ConeSettings {
+    /// Full aperture of the diffuse cones, degrees.
+    pub diffuse_aperture_deg: f32,
+    /// Step length as a fraction of the cone diameter (beta).
+    pub step_factor: f32,
+    /// Light bounces between voxels: 1 is direct light on the voxels only.
+    pub bounces: u32,
+}
+
+impl Default for ConeSettings {
+    fn default() -> Self {
+        Self {
+            diffuse_aperture_deg: 60.0,
+            step_factor: 0.5,
+            bounces: 2,
+        }
+    }
+}
+
+/// The voxel volumes.
+struct Volumes {
+    albedo: Image,
+    normal: Image,
+    emission: Image,
+    radiance: Image,
+    /// Direct light only, the starting point of each bounce.
+    direct: Image,
+    /// +X -X +Y -Y +Z -Z, each resolution / 2 with a full mip chain.
+    directional: Vec<Image>,
+}
+
+const PACKED_FORMAT: vk::Format = vk::Format::R32_UINT;
+const RADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+impl Volumes {
+    fn new(ctx: &Arc<Context>, n: u32) -> Result<Self> {
+        let packed_usage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_DST;
+        let packed = |name| Image::new(ctx, name, ImageDesc::d3(PACKED_FORMAT, n, 1, packed_usage));
+        let radiance_usage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED;
+        let levels = n.trailing_zeros();
+        let directional = ["+x", "-x", "+y", "-y", "+z", "-z"]
+            .iter()
+            .map(|d| {
+                Image::new(
+                    ctx,
+                    &format!("voxel radiance {d}"),
+                    ImageDesc::d3(RADIANCE_FORMAT, n / 2, levels, radiance_usage),
+                )
+            })
+            .collect::<Result<_>>()?;
+        Ok(Self {
+            albedo: packed("voxel albedo")?,
+            normal: packed("voxel normal")?,
+            emission: packed("voxel emission")?,
+            radiance: Image::new(
+                ctx,
+                "voxel radiance",
+                ImageDesc::d3(RADIANCE_FORMAT, n, 1, radiance_usage),
+            )?,
+            direct: Image::new(
+                ctx,
+                "voxel direct",
+                ImageDesc::d3(RADIANCE_FORMAT, n, 1, radiance_usage),
+            )?,
+            directional,
+        })
+    }
+
+    fn packed(&self) -> [&Image; 3] {
+        [&self.albedo, &self.normal, &self.emission]
+    }
+
+    fn bytes(&self) -> Vec<(&'static str, u64)> {
+        vec![
+            ("voxel_albedo", self.albedo.memory_bytes()),
+            ("voxel_normal", self.normal.memory_bytes()),
+            ("voxel_emission", self.emission.memory_bytes()),
+            ("voxel_radiance", self.radiance.memory_bytes()),
+            ("voxel_direct", self.direct.memory_bytes()),
+            (
+                "voxel_radiance_directional",
+                self.directional.iter().map(Image::memory_bytes).sum(),
+            ),
+        ]
+    }
+}
+
+/// The set-2 bindings every GI pass shares.
+fn gi_bindings() -> Vec<Binding> {
+    let all = vk::ShaderStageFlags::FRAGMENT
+        | vk::ShaderStageFlags::COMPUTE
+        | vk::ShaderStageFlags::GEOMETRY;
+    let storage = vk::DescriptorType::STORAGE_IMAGE;
+    let sampled = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
+    vec![
+        Binding::new(
+            layout::BINDING_GI_UNIFORMS,
+            vk::DescriptorType::UNIFORM_BUFFER,
+            all,
+        ),
+        Binding::new(layout::BINDING_GI_ALBEDO, storage, all),
+        Binding::new(layout::BINDING_GI_NORMAL, storage, all),
+        Binding::new(layout::BINDING_GI_EMISSION, storage, all),
+        Binding::new(layout::BINDING_GI_RADIANCE, storage, all),
+        Binding::new(layout::BINDING_GI_RADIANCE_SAMPLED, sampled, all),
+        Binding::new(layout::BINDING_GI_DIRECTIONAL, sampled, all).array(6),
+        Binding::new(layout::BINDING_GI_SCREEN, storage, all),
+        Binding::new(layout::BINDING_GI_GBUFFER_ALBEDO, storage, all),
+        Binding::new(layout::BINDING_GI_GBUFFER_NORMAL, storage, all),
+        Binding::new(layout::BINDING_GI_GBUFFER_DEPTH, sampled, all),
+        Binding::new(layout::BINDING_GI_DIRECT, storage, all),
+    ]
+}
+
+/// A global barrier between two compute passes: writes before are visible to reads and
+/// writes after.
+fn compute_to_compute(ctx: &Context, cmd: vk::CommandBuffer) {
+    let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
+    memory_barrier(
+        ctx,
+        cmd,
+        (compute, vk::AccessFlags2::SHADER_WRITE),
+        (
+            compute,
+            vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE,
+        ),
+    );
+}
+
+pub struct DenseGi {
+    pub grid: Grid,
+    volumes: Volumes,
+    voxelize: voxelize::VoxelizePass,
+    inject: inject::InjectPass,
+    bounces: u32,
+    filter: filter::FilterPass,
+    cone_trace: cone_trace::ConeTracePass,
+    set: vk::DescriptorSet,
+    _sets: DescriptorSets,
+    _uniforms: Buffer,
+    linear: Sampler,
+    ctx: Arc<Context>,
+}
+
+impl DenseGi {
+    /// `set_layouts` are those of sets 0 and 1.
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        resolution: u32,
+        cones: ConeSettings,
+        set_layouts: [vk::DescriptorSetLayout; 2],
+    ) -> Result<Self> {
+        if !resolution.is_power_of_two() || !(4..=1024).contains(&resolution) {
+            bail!("--voxels must be a power of two between 4 and 1024, got {resolution}");
+        }
+        if !ctx.features.geometry_shader || !ctx.features.fragment_stores_and_atomics {
+            bail!(
+                "--gi dense needs geometry shaders and fragment stores/atomics, which {} lacks",
+                ctx.device_name()
+            );
+        }
+        let grid = Grid::around(scene, resolution);
+        let volumes = Volumes::new(ctx, resolution)?;
+        let emission_range = scene
+            .materials
+            .iter()
+            .map(|m| m.emission.max_element())
+            .fold(0.0f32, f32::max)
+            .max(1e-6);
+        let uniforms = GiUniforms {
+            origin: grid.origin.extend(grid.voxel_size).to_array(),
+            resolution,
+            directional_levels: resolution.trailing_zeros(),
+            emission_range,
+            step_factor: cones.step_factor,
+            diffuse_tan_half: (cones.diffuse_aperture_deg.to_radians() * 0.5).tan(),
+            max_distance: grid.voxel_size * resolution as f32 * 1.8,
+            ..Default::default()
+        };
+        let uniforms = Buffer::with_data(
+            ctx,
+            "gi uniforms",
+            bytemuck::bytes_of(&uniforms),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let sets = DescriptorSets::new(ctx, "gi", &gi_bindings(), 1)?;
+        let set = sets.allocate("gi")?;
+        let linear = Sampler::new(
+            ctx,
+            "voxel linear",
+            &vk::SamplerCreateInfo::default()
+                .mag_filter(vk::Filter::LINEAR)
+                .min_filter(vk::Filter::LINEAR)
+                .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
+                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_BORDER)
+                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_BORDER)
+                .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_BORDER)
+                .border_color(vk::BorderColor::FLOAT_TRANSPARENT_BLACK)
+                .max_lod(vk::LOD_CLAMP_NONE),
+        )?;
+        let directional: Vec<_> = volumes
+            .directional
+            .iter()
+            .map(|image| vk::DescriptorImageInfo {
+                sampler: linear.raw,
+                image_view: image.view,
+                image_layout: vk::ImageLayout::GENERAL,
+            })
+            .collect();
+        SetWriter::new(ctx, set)
+            .buffer(
+                layout::BINDING_GI_UNIFORMS,
+                vk::DescriptorType::UNIFORM_BUFFER,
+                uniforms.raw,
+            )
+            .storage_image(layout::BINDING_GI_ALBEDO, volumes.albedo.view)
+            .storage_image(layout::BINDING_GI_NORMAL, volumes.normal.view)
+            .storage_image(layout::BINDING_GI_EMISSION, volumes.emission.view)
+            .storage_image(layout::BINDING_GI_RADIANCE, volumes.radiance.view)
+            .storage_image(layout::BINDING_GI_DIRECT, volumes.direct.view)
+            .sampled_image(
+                layout::BINDING_GI_RADIANCE_SAMPLED,
+                volumes.radiance.view,
+                linear.raw,
+                vk::ImageLayout::GENERAL,
+            )
+            .images(
+                layout::BINDING_GI_DIRECTIONAL,
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                directional,
+            )
+            .apply();
+        // The radiance volumes stay in GENERAL: written as storage, sampled by cones.
+        OneShot::new(ctx)?.run("gi volume layouts", |cmd| {
+            for image in [&volumes.radiance, &volumes.direct]
+                .into_iter()
+                .chain(&volumes.directional)
+            {
+                image_barrier(
+                    ctx,
+                    cmd,
+                    image.raw,
+                    image.full_range(),
+                    ImageUse::UNDEFINED,
+                    ImageUse::COMPUTE_WRITE,
+                );
+            }
+            Ok(())
+        })?;
+        let gi_layout = sets.layout;
+        Ok(Self {
+            grid,
+            voxelize: voxelize::VoxelizePass::new(
+                ctx,
+                [set_layouts[0], set_layouts[1], gi_layout],
+            )?,
+            inject: inject::InjectPass::new(ctx, [set_layouts[0], set_layouts[1], gi_layout])?,
+            bounces: cones.bounces.max(1),
+            filter: filter::FilterPass::new(ctx, set_layouts, &volumes)?,
+            cone_trace: cone_trace::ConeTracePass::new(
+                ctx,
+                [set_layouts[0], set_layouts[1], gi_layout],
+            )?,
+            volumes,
+            set,
+            _sets: sets,
+            _uniforms: uniforms,
+            linear,
+            ctx: ctx.clone(),
+        })
+    }
+
+    /// Points the cone tracer at new screen targets; no frame using the old ones may be
+    /// in flight.
+    pub fn bind_screen(&self, gbuffer: &GBuffer, radiance: &Image, depth_sampler: vk::Sampler) {
+        SetWriter::new(&self.ctx, self.set)
+            .storage_image(layout::BINDING_GI_SCREEN, radiance.view)
+            .storage_image(layout::BINDING_GI_GBUFFER_ALBEDO, gbuffer.albedo.view)
+            .storage_image(layout::BINDING_GI_GBUFFER_NORMAL, gbuffer.normal.view)
+            .sampled_image(
+                layout::BINDING_GI_GBUFFER_DEPTH,
+                gbuffer.depth.view,
+                depth_sampler,
+                vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
+            )
+            .apply();
+    }
+
+    /// GPU memory of every voxel volume, by name.
+    pub fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
+        self.volumes.bytes()
+    }
+
+    /// Voxelizes the scene and lights and filters the voxels (after the shadow maps).
+    pub fn record_update(&self, cmd: vk::CommandBuffer, timer: &mut GpuTimer, draw: &SceneDraw) {
+        let ctx = &self.ctx;
+        timer.begin(cmd, "voxelize");
+        for image in self.volumes.packed() {
+            // Last frame's injection read these; the clear may start after it.
+            image_barrier(
+                ctx,
+                cmd,
+                image.raw,
+                image.full_range(),
+                ImageUse::discard_after(ImageUse::COMPUTE_STORAGE_READ),
+                ImageUse::TRANSFER_DST,
+            );
+            let zero = vk::ClearColorValue { uint32: [0; 4] };
+            unsafe {
+                ctx.device.cmd_clear_color_image(
+                    cmd,
+                    image.raw,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &zero,
+                    &[image.full_range()],
+                )
+            };
+            image_barrier(
+                ctx,
+                cmd,
+                image.raw,
+                image.full_range(),
+                ImageUse::TRANSFER_DST,
+                voxelize::VoxelizePass::IMAGE_USE,
+            );
+        }
+        self.voxelize
+            .record(ctx, cmd, draw, self.set, self.grid.resolution);
+        timer.end(cmd);
+
+        timer.begin(cmd, "inject");
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE | vk::AccessFlags2::SHADER_STORAGE_READ,
+            ),
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ,
+            ),
+        );
+        // Last frame's cone tracing sampled the radiance volumes that are rewritten now.
+        compute_to_compute(ctx, cmd);
+        self.inject
+            .record(ctx, cmd, draw.sets[0].1, self.set, self.grid.resolution);
+        timer.end(cmd);
+
+        timer.begin(cmd, "filter");
+        compute_to_compute(ctx, cmd);
+        self.filter.record(ctx, cmd, self.grid.resolution);
+        timer.end(cmd);
+
+        for _ in 1..self.bounces {
+            timer.begin(cmd, "bounce");
+            compute_to_compute(ctx, cmd);
+            self.inject
+                .record_bounce(ctx, cmd, draw.sets[0].1, self.set, self.grid.resolution);
+            compute_to_compute(ctx, cmd);
+            self.filter.record(ctx, cmd, self.grid.resolution);
+            timer.end(cmd);
+        }
+    }
+
+    /// Adds the cone-traced indirect light to `radiance` (written by the lighting pass).
+    pub fn record_gather(
+        &self,
+        cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
+        frame_set: vk::DescriptorSet,
+        extent: vk::Extent2D,
+    ) {
+        timer.begin(cmd, "cone_trace");
+        compute_to_compute(&self.ctx, cmd);
+        self.cone_trace
+            .record(&self.ctx, cmd, frame_set, self.set, extent);
+        timer.end(cmd);
+    }
+
+    pub fn sampler(&self) -> vk::Sampler {
+        self.linear.raw
+    }
+}
