@@ -76,7 +76,7 @@ pub struct CommonArgs {
     #[arg(long, default_value_t = 64)]
     pub voxels: u32,
     /// Light bounces between voxels (1: direct light on the voxels only).
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub bounces: u32,
     /// Scene time in seconds (animation).
     #[arg(long, default_value_t = 0.0)]

@@ -72,6 +72,8 @@ gpu_layout! {
         BINDING_FILTER_SRC = 0;
         /// filter pass (set 2): the level written, `rgba16f` storage `[6]`.
         BINDING_FILTER_DST = 1;
+        /// filter pass (set 2): the voxel normals, oriented to the lit side by injection.
+        BINDING_FILTER_NORMAL = 2;
         /// Workgroup edge of the 3D compute passes.
         VOXEL_GROUP_SIZE = 4;
         /// Cones of the diffuse gather.

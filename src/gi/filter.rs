@@ -31,6 +31,7 @@ impl FilterPass {
         let bindings = [
             Binding::new(layout::BINDING_FILTER_SRC, storage, compute).array(6),
             Binding::new(layout::BINDING_FILTER_DST, storage, compute).array(6),
+            Binding::new(layout::BINDING_FILTER_NORMAL, storage, compute),
         ];
         let levels = volumes.directional[0].desc.mip_levels;
         let sets = DescriptorSets::new(ctx, "filter", &bindings, levels)?;
@@ -39,7 +40,7 @@ impl FilterPass {
             "filter",
             crate::vk::shaders::GI_FILTER_FILTER_COMP,
             &[set_layouts[0], set_layouts[1], sets.layout],
-            0,
+            4,
         )?;
         let mut views = Vec::new();
         for level in 0..levels {
@@ -70,6 +71,7 @@ impl FilterPass {
             SetWriter::new(ctx, set)
                 .images(layout::BINDING_FILTER_SRC, storage, src)
                 .images(layout::BINDING_FILTER_DST, storage, dst)
+                .storage_image(layout::BINDING_FILTER_NORMAL, volumes.normal.view)
                 .apply();
             level_sets.push(set);
         }
@@ -88,6 +90,8 @@ impl FilterPass {
                 compute_to_compute(ctx, cmd);
             }
             self.pipeline.bind(cmd, &[(layout::SET_PASS, set)]);
+            self.pipeline
+                .push(cmd, vk::ShaderStageFlags::COMPUTE, &(level as u32));
             let size = (n >> (level + 1)).max(1);
             let g = groups(size, layout::VOXEL_GROUP_SIZE);
             unsafe { ctx.device.cmd_dispatch(cmd, g, g, g) };

@@ -63,7 +63,7 @@ impl Default for ConeSettings {
         Self {
             diffuse_aperture_deg: 60.0,
             step_factor: 0.5,
-            bounces: 2,
+            bounces: 4,
         }
     }
 }

@@ -8,6 +8,31 @@
 layout(local_size_x = VOXEL_GROUP_SIZE, local_size_y = VOXEL_GROUP_SIZE, local_size_z = VOXEL_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_FILTER_SRC, rgba16f) uniform readonly image3D src[6];
 layout(set = SET_PASS, binding = BINDING_FILTER_DST, rgba16f) uniform writeonly image3D dst[6];
+layout(set = SET_PASS, binding = BINDING_FILTER_NORMAL, r32ui) uniform readonly uimage3D voxel_normal;
+layout(push_constant) uniform FilterPush {
+    uint level;
+};
+
+// Of a base voxel's radiance, the part a cone travelling along `d` sees: all of it when
+// the cone looks at the voxel's lit face, none from behind, half edge-on. Opacity stays:
+// the voxel blocks the cone either way. Without this, a cone leaving a surface gathers
+// the surface's own light from the coarse cell around its start.
+vec4 facing(ivec3 voxel, vec4 value, int d) {
+    uint packed_normal = imageLoad(voxel_normal, voxel).r;
+    vec3 n = vec3(float(packed_normal & 0xffu), float((packed_normal >> 8) & 0xffu), float((packed_normal >> 16) & 0xffu)) / 127.5 - 1.0;
+    if (length(n) < 0.2) {
+        return value;
+    }
+    vec3 towards_viewer = vec3(0.0);
+    towards_viewer[d / 2] = (d % 2 == 0) ? -1.0 : 1.0;
+    float w = clamp(0.5 + dot(normalize(n), towards_viewer), 0.0, 1.0);
+    return value * w;
+}
+
+vec4 load(int d, ivec3 voxel) {
+    vec4 value = imageLoad(src[d], voxel);
+    return level == 0u ? facing(voxel, value, d) : value;
+}
 
 vec4 over(vec4 front, vec4 back) {
     return front + (1.0 - front.a) * back;
@@ -32,7 +57,7 @@ void main() {
                 ivec3 b = f;
                 f[axis] = front;
                 b[axis] = 1 - front;
-                sum += over(imageLoad(src[d], base + f), imageLoad(src[d], base + b));
+                sum += over(load(d, base + f), load(d, base + b));
             }
         }
         imageStore(dst[d], parent, sum * 0.25);

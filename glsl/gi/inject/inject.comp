@@ -8,7 +8,7 @@
 
 layout(local_size_x = VOXEL_GROUP_SIZE, local_size_y = VOXEL_GROUP_SIZE, local_size_z = VOXEL_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform readonly uimage3D voxel_albedo;
-layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform readonly uimage3D voxel_normal;
+layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform uimage3D voxel_normal;
 layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform readonly uimage3D voxel_emission;
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance;
 layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform writeonly image3D voxel_direct;
@@ -25,21 +25,30 @@ void main() {
         return;
     }
     vec3 rho = albedo.rgb / 255.0;
-    vec3 n = unpack_rgba8(imageLoad(voxel_normal, voxel).r).xyz / 255.0 * 2.0 - 1.0;
+    vec4 packed_normal = unpack_rgba8(imageLoad(voxel_normal, voxel).r);
+    vec3 n = packed_normal.xyz / 255.0 * 2.0 - 1.0;
     float len = length(n);
     // Opposite normals averaged in one voxel cancel; such a voxel faces every way.
     n = len > 0.2 ? n / len : vec3(0.0, 1.0, 0.0);
     vec3 p = voxel_center(voxel);
     float half_voxel = 0.5 * gi.origin.w;
-    vec3 e = vec3(0.0);
+    // Surfaces are two-sided: the voxel keeps the face that receives more light (emitters
+    // their winding face), and its normal is turned to that face so that the filter
+    // shows this radiance only to cones that look at the face.
+    vec3 front = vec3(0.0);
+    vec3 back = vec3(0.0);
     for (uint i = 0u; i < frame.light_count; i++) {
         vec3 l;
-        // Surfaces are two-sided: light arriving on either face is reflected.
-        vec3 front = light_irradiance(lights[i], p, n, half_voxel, l);
-        vec3 back = light_irradiance(lights[i], p, -n, half_voxel, l);
-        e += (len > 0.2) ? max(front, back) : front + back;
+        front += light_irradiance(lights[i], p, n, half_voxel, l);
+        back += light_irradiance(lights[i], p, -n, half_voxel, l);
     }
     vec3 emission = unpack_rgba8(imageLoad(voxel_emission, voxel).r).rgb / 255.0 * gi.emission_range;
+    bool back_lit = dot(back, vec3(1.0)) > dot(front, vec3(1.0)) && all(equal(emission, vec3(0.0)));
+    vec3 e = len > 0.2 ? (back_lit ? back : front) : front + back;
+    if (len > 0.2) {
+        vec3 lit = back_lit ? -n : n;
+        imageStore(voxel_normal, voxel, uvec4(pack_rgba8(vec4((lit * 0.5 + 0.5) * 255.0, packed_normal.a))));
+    }
     vec4 radiance = vec4(rho / PI * e + emission, 1.0);
     imageStore(voxel_radiance, voxel, radiance);
     imageStore(voxel_direct, voxel, radiance);
