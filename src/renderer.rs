@@ -309,6 +309,11 @@ impl Renderer {
         self.targets.gbuffer.extent()
     }
 
+    /// The dense voxel GI, when enabled.
+    pub fn dense_gi(&self) -> Option<&DenseGi> {
+        self.gi.as_ref()
+    }
+
     /// GPU memory of the voxel volumes, by name (empty without GI).
     pub fn gi_memory_bytes(&self) -> Vec<(&'static str, u64)> {
         self.gi

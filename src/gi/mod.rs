@@ -7,6 +7,10 @@
 mod cone_trace;
 mod filter;
 mod inject;
+#[cfg(test)]
+pub mod reference;
+#[cfg(test)]
+mod tests;
 mod voxelize;
 
 use std::sync::Arc;
@@ -34,6 +38,12 @@ pub struct Grid {
 }
 
 impl Grid {
+    /// Linear index of voxel (i, j, k): x fastest, then y, then z (the GPU's layout).
+    pub fn index(&self, i: u32, j: u32, k: u32) -> usize {
+        let n = self.resolution as usize;
+        i as usize + n * (j as usize + n * k as usize)
+    }
+
     /// A cube around the scene's bounds at time 0, with a little room so that surfaces
     /// on the bounds are not cut by the grid's edge.
     pub fn around(scene: &Scene, resolution: u32) -> Self {
@@ -85,9 +95,14 @@ const RADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
 impl Volumes {
     fn new(ctx: &Arc<Context>, n: u32) -> Result<Self> {
-        let packed_usage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_DST;
+        // Every volume can be copied out, for the checks against the CPU twins.
+        let packed_usage = vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::TRANSFER_DST
+            | vk::ImageUsageFlags::TRANSFER_SRC;
         let packed = |name| Image::new(ctx, name, ImageDesc::d3(PACKED_FORMAT, n, 1, packed_usage));
-        let radiance_usage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::SAMPLED;
+        let radiance_usage = vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::TRANSFER_SRC;
         let levels = n.trailing_zeros();
         let directional = ["+x", "-x", "+y", "-y", "+z", "-z"]
             .iter()
@@ -189,7 +204,8 @@ pub struct DenseGi {
     set: vk::DescriptorSet,
     _sets: DescriptorSets,
     _uniforms: Buffer,
-    linear: Sampler,
+    /// Referenced by the GI descriptor set.
+    _linear: Sampler,
     ctx: Arc<Context>,
 }
 
@@ -317,7 +333,7 @@ impl DenseGi {
             set,
             _sets: sets,
             _uniforms: uniforms,
-            linear,
+            _linear: linear,
             ctx: ctx.clone(),
         })
     }
@@ -430,7 +446,112 @@ impl DenseGi {
         timer.end(cmd);
     }
 
-    pub fn sampler(&self) -> vk::Sampler {
-        self.linear.raw
+    /// Downloads one level of a volume, texel after texel (x fastest), once the frames
+    /// that write it are done: the check of each stage against its CPU twin reads it.
+    pub fn download(&self, volume: Volume, level: u32) -> Result<Vec<u8>> {
+        let v = &self.volumes;
+        let image = match volume {
+            Volume::Albedo => &v.albedo,
+            Volume::Normal => &v.normal,
+            Volume::Emission => &v.emission,
+            Volume::Radiance => &v.radiance,
+            Volume::Directional(d) => &v.directional[d],
+        };
+        let n = (image.desc.extent.width >> level).max(1);
+        let texel = if image.desc.format == PACKED_FORMAT {
+            4
+        } else {
+            8
+        };
+        let buffer = Buffer::new(
+            &self.ctx,
+            "volume readback",
+            u64::from(n).pow(3) * texel,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            gpu_allocator::MemoryLocation::GpuToCpu,
+        )?;
+        let range = vk::ImageSubresourceRange {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            base_mip_level: level,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let any_shader = ImageUse {
+            layout: vk::ImageLayout::GENERAL,
+            stage: vk::PipelineStageFlags2::ALL_COMMANDS,
+            access: vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE,
+        };
+        let ctx = &self.ctx;
+        OneShot::new(ctx)?.run("download volume", |cmd| {
+            image_barrier(
+                ctx,
+                cmd,
+                image.raw,
+                range,
+                any_shader,
+                ImageUse::TRANSFER_SRC,
+            );
+            let region = vk::BufferImageCopy {
+                buffer_offset: 0,
+                buffer_row_length: 0,
+                buffer_image_height: 0,
+                image_subresource: vk::ImageSubresourceLayers {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    mip_level: level,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                },
+                image_offset: vk::Offset3D::default(),
+                image_extent: vk::Extent3D {
+                    width: n,
+                    height: n,
+                    depth: n,
+                },
+            };
+            unsafe {
+                ctx.device.cmd_copy_image_to_buffer(
+                    cmd,
+                    image.raw,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    buffer.raw,
+                    &[region],
+                )
+            };
+            image_barrier(
+                ctx,
+                cmd,
+                image.raw,
+                range,
+                ImageUse::TRANSFER_SRC,
+                any_shader,
+            );
+            memory_barrier(
+                ctx,
+                cmd,
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                ),
+                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+            );
+            Ok(())
+        })?;
+        Ok(buffer.mapped().to_vec())
     }
+}
+
+/// A voxel volume, for [`DenseGi::download`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Volume {
+    /// Packed RGBA8 albedo; alpha counts the fragments (0 = empty voxel).
+    Albedo,
+    /// Packed RGBA8 normal (xyz * 0.5 + 0.5), turned to the lit side by injection.
+    Normal,
+    /// Packed RGBA8 emission / emission range.
+    Emission,
+    /// RGBA16F radiance, premultiplied by opacity.
+    Radiance,
+    /// RGBA16F directional volume +X -X +Y -Y +Z -Z (0..6).
+    Directional(usize),
 }

@@ -4,23 +4,8 @@
 
 use glam::{UVec3, Vec3};
 
-/// A cubic voxel grid: voxel (i, j, k) covers origin + [i, i+1) x [j, j+1) x [k, k+1)
-/// times `voxel_size`.
-#[derive(Clone, Copy, Debug)]
-pub struct Grid {
-    pub origin: Vec3,
-    pub voxel_size: f32,
-    pub resolution: u32,
-}
+pub use super::Grid;
 
-impl Grid {
-    /// Linear index of voxel (i, j, k): x fastest, then y, then z (the GPU's layout).
-    pub fn index(&self, i: u32, j: u32, k: u32) -> usize {
-        linear(self.resolution, UVec3::new(i, j, k))
-    }
-}
-
-/// Linear index of voxel `c` in a cube of resolution `n`, laid out as [`Grid::index`].
 fn linear(n: u32, c: UVec3) -> usize {
     let n = n as usize;
     c.x as usize + n * (c.y as usize + n * c.z as usize)
@@ -106,6 +91,17 @@ fn mark(triangles: &[[Vec3; 3]], grid: &Grid, grow: f32) -> Vec<bool> {
 
 /// Premultiplied RGBA `front` composited over `back`: what a ray sees passing through
 /// `front` first, then `back`.
+/// The weight `glsl/gi/filter/filter.comp` gives a base voxel with (lit-side) normal `n`
+/// for cones travelling along `direction`: 1 facing the cone, 0 from behind, 1/2 edge-on.
+pub fn facing_weight(n: Vec3, direction: usize) -> f32 {
+    if n.length() < 0.2 {
+        return 1.0;
+    }
+    let mut towards_viewer = Vec3::ZERO;
+    towards_viewer[direction / 2] = if direction % 2 == 0 { -1.0 } else { 1.0 };
+    (0.5 + n.normalize().dot(towards_viewer)).clamp(0.0, 1.0)
+}
+
 pub fn over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
     let transmittance = 1.0 - front[3];
     std::array::from_fn(|c| front[c] + transmittance * back[c])
@@ -286,6 +282,24 @@ mod tests {
         let hi = tri[0].max(tri[1]).max(tri[2]);
         assert!(lo.cmple(h).all() && hi.cmpge(-h).all());
         assert!(!tri_box_overlap(c, h, tri));
+    }
+
+    #[test]
+    fn triangle_past_a_corner_is_separated_by_its_normal() {
+        let (c, h) = UNIT_BOX;
+        // In the plane x + y + z = s: the box reaches s = 3 at its corner (1, 1, 1), and
+        // the triangle's projection along each box axis covers the box's, so neither the
+        // box normals nor the edge axes separate them.
+        let at = |s: f32| {
+            let o = (s - 10.0) / 2.0;
+            [
+                Vec3::new(10.0, o, o),
+                Vec3::new(o, 10.0, o),
+                Vec3::new(o, o, 10.0),
+            ]
+        };
+        assert!(!tri_box_overlap(c, h, at(3.1)));
+        assert!(tri_box_overlap(c, h, at(3.0)));
     }
 
     #[test]

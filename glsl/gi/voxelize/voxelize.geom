@@ -30,7 +30,8 @@ void main() {
     for (int i = 0; i < 3; i++) {
         p[i] = swizzle((in_world[i] - gi.origin.xyz) / gi.origin.w, axis);
     }
-    // Counter-clockwise in the projection, so the edge offsets below point outwards.
+    // Counter-clockwise in the projection: inside an edge line l is dot(l, (x, y, 1)) > 0,
+    // so raising l.z moves the edge outwards.
     int order[3] = int[3](0, 1, 2);
     vec2 e1 = p[1].xy - p[0].xy;
     vec2 e2 = p[2].xy - p[0].xy;
@@ -49,7 +50,7 @@ void main() {
         vec2 a = q[i].xy;
         vec2 b = q[(i + 1) % 3].xy;
         vec3 line = cross(vec3(a, 1.0), vec3(b, 1.0));
-        line.z -= 0.5 * (abs(line.x) + abs(line.y));
+        line.z += 0.5 * (abs(line.x) + abs(line.y));
         edge[i] = line;
     }
     vec2 lo = min(min(q[0].xy, q[1].xy), q[2].xy) - 0.5;

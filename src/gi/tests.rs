@@ -1,0 +1,203 @@
+//! The dense GI stages against their CPU twins (`reference.rs`), on the real device with
+//! validation on.
+
+use std::sync::Arc;
+
+use ash::vk;
+use glam::Vec3;
+
+use super::reference;
+use super::{Grid, Volume};
+use crate::frontend::{Offscreen, LDR_FORMAT};
+use crate::renderer::{GiSettings, OutputTarget, RenderSettings, Renderer};
+use crate::scene::{LoadOptions, Scene};
+use crate::vk::{Context, ContextOptions, ImageUse};
+
+fn shared_scene(path: &str) -> Option<std::path::PathBuf> {
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared")
+        .join(path);
+    if file.exists() {
+        Some(file)
+    } else {
+        eprintln!("skipped: {} is absent", file.display());
+        None
+    }
+}
+
+/// Renders one 64x64 frame of `scene` with `--gi dense --voxels n`.
+fn render(scene: Scene, n: u32) -> (Arc<Context>, Renderer) {
+    // Validation messages go to the log; show them when a test fails.
+    let _ = env_logger::builder().is_test(true).try_init();
+    let ctx = Context::new(&ContextOptions {
+        validation: true,
+        ..Default::default()
+    })
+    .unwrap();
+    let settings = RenderSettings {
+        gi: Some(GiSettings {
+            voxels: n,
+            cones: Default::default(),
+        }),
+        ..Default::default()
+    };
+    let extent = vk::Extent2D {
+        width: 64,
+        height: 64,
+    };
+    let offscreen = Offscreen::new(&ctx, extent).unwrap();
+    let mut renderer = Renderer::new(&ctx, scene, settings, extent, LDR_FORMAT).unwrap();
+    let target = OutputTarget {
+        image: offscreen.image.raw,
+        view: offscreen.image.view,
+        extent,
+        before: ImageUse::UNDEFINED,
+        after: ImageUse::COLOR_ATTACHMENT,
+    };
+    let frame = renderer.begin_frame().unwrap();
+    renderer.record_frame(&frame, 0.0, &target).unwrap();
+    renderer.submit(frame, None, None).unwrap();
+    renderer.finish().unwrap();
+    (ctx, renderer)
+}
+
+fn world_triangles(scene: &Scene) -> Vec<[Vec3; 3]> {
+    let mut triangles = Vec::new();
+    for (m, mesh) in scene.meshes.iter().enumerate() {
+        let model = scene.mesh_transform(m, 0.0);
+        for t in mesh.indices.chunks_exact(3) {
+            triangles.push(
+                [t[0], t[1], t[2]].map(|i| {
+                    model.transform_point3(Vec3::from(mesh.vertices[i as usize].position))
+                }),
+            );
+        }
+    }
+    triangles
+}
+
+fn occupancy(renderer: &Renderer) -> Vec<bool> {
+    let bytes = renderer
+        .dense_gi()
+        .unwrap()
+        .download(Volume::Albedo, 0)
+        .unwrap();
+    bytes.chunks_exact(4).map(|t| t[3] > 0).collect()
+}
+
+/// Every voxel a triangle touches is occupied on the GPU, and the GPU's conservative
+/// rasterization adds none farther than one voxel from a triangle.
+fn check_voxelization(scene: Scene, n: u32) {
+    let triangles = world_triangles(&scene);
+    let (ctx, renderer) = render(scene, n);
+    let grid: Grid = renderer.dense_gi().unwrap().grid;
+    let gpu = occupancy(&renderer);
+    let exact = reference::voxelize(&triangles, &grid);
+    let near = reference::within_one_voxel(&triangles, &grid);
+    let missing = exact.iter().zip(&gpu).filter(|(c, g)| **c && !**g).count();
+    let extra = near.iter().zip(&gpu).filter(|(c, g)| !**c && **g).count();
+    let cpu_count = exact.iter().filter(|c| **c).count();
+    let gpu_count = gpu.iter().filter(|g| **g).count();
+    eprintln!("{n}^3: CPU {cpu_count} voxels, GPU {gpu_count}, missing {missing}, too far {extra}");
+    assert!(cpu_count > 0);
+    assert_eq!(missing, 0, "voxels the CPU marks but the GPU does not");
+    assert_eq!(
+        extra, 0,
+        "GPU voxels farther than one voxel from every triangle"
+    );
+    assert_eq!(ctx.validation_messages(), 0);
+}
+
+#[test]
+fn voxelization_matches_cpu_on_cornell_box() {
+    let Some(path) = shared_scene("scenes/cornell_box/CornellBox-Original.obj") else {
+        return;
+    };
+    for n in [32, 64] {
+        check_voxelization(Scene::load(&path, &LoadOptions::default()).unwrap(), n);
+    }
+}
+
+#[test]
+fn voxelization_matches_cpu_on_a_rotated_thin_mesh() {
+    let dir = std::env::temp_dir().join(format!("voxcone-thin-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A 2 x 0.02 x 1.3 slab, thinner than a voxel, tilted on all three axes, inside a
+    // unit box that sets the grid's extent.
+    let obj = "v -1 -0.01 -0.65\nv 1 -0.01 -0.65\nv 1 0.01 -0.65\nv -1 0.01 -0.65\n\
+               v -1 -0.01 0.65\nv 1 -0.01 0.65\nv 1 0.01 0.65\nv -1 0.01 0.65\n\
+               f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n";
+    std::fs::write(dir.join("slab.obj"), obj).unwrap();
+    std::fs::write(
+        dir.join("scene.toml"),
+        "[[mesh]]\npath = \"slab.obj\"\nrotate_deg = [23, 41, 17]\n",
+    )
+    .unwrap();
+    let scene = Scene::load(&dir.join("scene.toml"), &LoadOptions::default()).unwrap();
+    for n in [32, 64] {
+        check_voxelization(scene.clone(), n);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+fn halves(bytes: &[u8]) -> Vec<[f32; 4]> {
+    bytes
+        .chunks_exact(8)
+        .map(|t| {
+            let h = |i: usize| half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32();
+            [h(0), h(1), h(2), h(3)]
+        })
+        .collect()
+}
+
+/// Each level of each directional volume equals the CPU filter applied to the level
+/// below as downloaded (the first level: the base radiance, weighted by which way each
+/// voxel's lit face looks), within half-float rounding.
+#[test]
+fn filter_matches_cpu() {
+    let Some(path) = shared_scene("reference/cornell_point.scene.json") else {
+        return;
+    };
+    let options = LoadOptions {
+        diffuse_only: true,
+        no_normal_maps: true,
+    };
+    let n = 32;
+    let (ctx, renderer) = render(Scene::load(&path, &options).unwrap(), n);
+    let gi = renderer.dense_gi().unwrap();
+    let base = halves(&gi.download(Volume::Radiance, 0).unwrap());
+    let normals: Vec<Vec3> = gi
+        .download(Volume::Normal, 0)
+        .unwrap()
+        .chunks_exact(4)
+        .map(|t| Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 127.5 - 1.0)
+        .collect();
+    let mut worst = 0.0f32;
+    for d in 0..6 {
+        let mut below: Vec<[f32; 4]> = base
+            .iter()
+            .zip(&normals)
+            .map(|(v, n)| v.map(|c| c * reference::facing_weight(*n, d)))
+            .collect();
+        let mut size = n;
+        for level in 0..n.trailing_zeros() {
+            let cpu = reference::filter_directional(&below, size, d);
+            let gpu = halves(&gi.download(Volume::Directional(d), level).unwrap());
+            for (c, g) in cpu.iter().zip(&gpu) {
+                for k in 0..4 {
+                    let err = (c[k] - g[k]).abs() / c[k].abs().max(1.0);
+                    worst = worst.max(err);
+                    assert!(
+                        err <= 2.0 / 1024.0,
+                        "direction {d} level {level}: CPU {c:?} GPU {g:?}"
+                    );
+                }
+            }
+            below = gpu;
+            size /= 2;
+        }
+    }
+    eprintln!("filter: worst relative difference {worst:.2e}");
+    assert!(base.iter().any(|v| v[3] > 0.0), "empty radiance volume");
+    assert_eq!(ctx.validation_messages(), 0);
+}
