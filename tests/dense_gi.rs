@@ -79,3 +79,93 @@ fn cornell_point_dense_gi() {
         "indirect light adds no colour bleeding"
     );
 }
+
+fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Mean RGB of the centre 8x8 pixels.
+fn centre(path: &Path) -> [f32; 3] {
+    let (image, _) = load_rgb(path).unwrap();
+    let (w, h) = (image.width as usize, image.height as usize);
+    let mut sum = [0.0; 3];
+    for y in h / 2 - 4..h / 2 + 4 {
+        for x in w / 2 - 4..w / 2 + 4 {
+            for (c, s) in sum.iter_mut().enumerate() {
+                *s += image.data[(y * w + x) * 3 + c] / 64.0;
+            }
+        }
+    }
+    sum
+}
+
+/// Furnace: inside a closed box whose walls emit radiance L (albedo 0, no lights), a
+/// white surface gathers L: its pixel is albedo x L.
+#[test]
+fn furnace_closed_box_gathers_wall_radiance() {
+    let dir = temp_dir("furnace");
+    write(
+        &dir,
+        "box.mtl",
+        "newmtl wall\nKd 0 0 0\nKe 0.5 0.5 0.5\nnewmtl probe\nKd 1 1 1\n",
+    );
+    // A cube [-1, 1]^3 wound so that every face's normal points inwards, and a small
+    // white probe quad facing +Z in the middle.
+    let obj = "mtllib box.mtl\n\
+        v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+        v -0.2 -0.2 0\nv 0.2 -0.2 0\nv 0.2 0.2 0\nv -0.2 0.2 0\n\
+        usemtl wall\nf 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n\
+        usemtl probe\nf 9 10 11 12\n";
+    write(&dir, "box.obj", obj);
+    let scene = write(
+        &dir,
+        "furnace.toml",
+        "[camera]\nposition = [0, 0, 0.9]\ntarget = [0, 0, 0]\nfov_y_deg = 10\n[[mesh]]\npath = \"box.obj\"\n",
+    );
+    let out = dir.join("furnace.exr");
+    render(&scene, "dense", &out);
+    let probe = centre(&out);
+    eprintln!("furnace: probe radiance {probe:?}, walls 0.5");
+    for c in probe {
+        assert!((c - 0.5).abs() <= 0.05, "gathered {c}, walls emit 0.5");
+    }
+}
+
+/// An open white plane under an empty sky of radiance S gathers S.
+#[test]
+fn open_plane_gathers_the_sky() {
+    let dir = temp_dir("sky");
+    write(&dir, "plane.mtl", "newmtl white\nKd 1 1 1\n");
+    write(
+        &dir,
+        "plane.obj",
+        "mtllib plane.mtl\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\nusemtl white\nf 1 2 3 4\n",
+    );
+    let scene = write(
+        &dir,
+        "sky.toml",
+        "[camera]\nposition = [0, 1, 0.01]\ntarget = [0, 0, 0]\nfov_y_deg = 20\n\
+         [[mesh]]\npath = \"plane.obj\"\n[sky]\nradiance = [0.2, 0.3, 0.4]\n",
+    );
+    let out = dir.join("sky.exr");
+    render(&scene, "dense", &out);
+    let plane = centre(&out);
+    eprintln!("open plane: radiance {plane:?}, sky [0.2, 0.3, 0.4]");
+    for (c, s) in plane.iter().zip([0.2, 0.3, 0.4]) {
+        assert!((c - s).abs() <= 0.1 * s, "gathered {c}, sky {s}");
+    }
+}
+
+/// Two renders of the same static frame are identical (no atomic-order flicker).
+#[test]
+fn renders_are_deterministic() {
+    let Some(shared) = shared() else { return };
+    let scene = shared.join("reference/cornell_point.scene.json");
+    let dir = temp_dir("determinism");
+    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+    render(&scene, "dense", &a);
+    render(&scene, "dense", &b);
+    assert_eq!(load_rgb(&a).unwrap().0.data, load_rgb(&b).unwrap().0.data);
+}
