@@ -94,15 +94,18 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
             continue;
         }
         walls.push(start.elapsed().as_secs_f64() * 1e3);
-        let mut total = 0.0;
+        // A pass that runs several times a frame (one per bounce) counts once, summed.
+        let mut frame: BTreeMap<&str, f64> = BTreeMap::new();
         for (name, ms) in &renderer.timings {
             if !order.contains(name) {
                 order.push(name.clone());
             }
-            samples.entry(name.clone()).or_default().push(*ms);
-            total += ms;
+            *frame.entry(name).or_default() += ms;
         }
-        totals.push(total);
+        for (name, ms) in &frame {
+            samples.entry(name.to_string()).or_default().push(*ms);
+        }
+        totals.push(frame.values().sum());
     }
     let passes = samples
         .iter()
@@ -116,6 +119,12 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
     }
     let mut stats_map = BTreeMap::new();
     stats_map.insert("triangles".to_string(), triangles as f64);
+    if let Some(gi) = renderer.dense_gi() {
+        let albedo = gi.download(crate::gi::Volume::Albedo, 0)?;
+        let occupied = albedo.chunks_exact(4).filter(|t| t[3] > 0).count();
+        stats_map.insert("voxels".to_string(), f64::from(gi.grid.resolution));
+        stats_map.insert("occupied_voxels".to_string(), occupied as f64);
+    }
     let report = BenchReport {
         device: ctx.device_name(),
         driver: ctx.driver.clone(),
