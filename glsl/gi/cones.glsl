@@ -8,6 +8,19 @@
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE_SAMPLED) uniform sampler3D voxel_radiance;
 layout(set = SET_PASS, binding = BINDING_GI_DIRECTIONAL) uniform sampler3D voxel_directional[6];
 
+// The directional volume facing a cone travelling along +axis (positive) or -axis.
+// Descriptor arrays are indexed by constants only: the sign differs between neighbouring
+// invocations, and non-uniform indexing is an optional feature lavapipe lacks (indexing
+// with it anyway gave 8x8-pixel blocks, one per workgroup).
+vec4 sample_directional(int axis, bool positive, vec3 uvw, float level) {
+    if (axis == 0) {
+        return positive ? textureLod(voxel_directional[0], uvw, level) : textureLod(voxel_directional[1], uvw, level);
+    } else if (axis == 1) {
+        return positive ? textureLod(voxel_directional[2], uvw, level) : textureLod(voxel_directional[3], uvw, level);
+    }
+    return positive ? textureLod(voxel_directional[4], uvw, level) : textureLod(voxel_directional[5], uvw, level);
+}
+
 // Voxel radiance at `uvw` for a cone travelling along `dir` with footprint `lod` (0 = one
 // voxel): the base level below lod 1, blended into the three directional volumes facing
 // the cone, weighted by the squared direction components.
@@ -18,9 +31,9 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
     }
     vec3 w = dir * dir;
     float level = max(lod - 1.0, 0.0);
-    vec4 aniso = w.x * textureLod(voxel_directional[dir.x >= 0.0 ? 0 : 1], uvw, level)
-        + w.y * textureLod(voxel_directional[dir.y >= 0.0 ? 2 : 3], uvw, level)
-        + w.z * textureLod(voxel_directional[dir.z >= 0.0 ? 4 : 5], uvw, level);
+    vec4 aniso = w.x * sample_directional(0, dir.x >= 0.0, uvw, level)
+        + w.y * sample_directional(1, dir.y >= 0.0, uvw, level)
+        + w.z * sample_directional(2, dir.z >= 0.0, uvw, level);
     return lod < 1.0 ? mix(base, aniso, lod) : aniso;
 }
 

@@ -260,10 +260,11 @@ impl DenseGi {
                 .mag_filter(vk::Filter::LINEAR)
                 .min_filter(vk::Filter::LINEAR)
                 .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
-                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_BORDER)
-                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_BORDER)
-                .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_BORDER)
-                .border_color(vk::BorderColor::FLOAT_TRANSPARENT_BLACK)
+                // Not a transparent border: at coarse levels the grid is a few texels
+                // across, and filtering towards a border would thin every wall there.
+                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
                 .max_lod(vk::LOD_CLAMP_NONE),
         )?;
         let directional: Vec<_> = volumes

@@ -1,7 +1,7 @@
 #version 460
 // One more bounce of light between voxels (Villegas 2018 §4): each occupied voxel gathers
-// the filtered radiance over its normal's hemisphere (both hemispheres, keeping the
-// brighter, as surfaces are two-sided) and adds albedo times it to its direct radiance.
+// the filtered radiance over the hemisphere of its lit face (injection turned the normal
+// to it) and adds albedo times it to its direct radiance.
 // Cones read only the directional levels (lod >= 1), never the base level rewritten here.
 #include "gi/cones.glsl"
 
@@ -10,10 +10,6 @@ layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform readonly uima
 layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform readonly uimage3D voxel_normal;
 layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform readonly image3D voxel_direct;
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance_out;
-
-float luminance(vec3 c) {
-    return dot(c, vec3(0.2126, 0.7152, 0.0722));
-}
 
 void main() {
     ivec3 voxel = ivec3(gl_GlobalInvocationID);
@@ -28,9 +24,7 @@ void main() {
     n = length(n) > 0.2 ? normalize(n) : vec3(0.0, 1.0, 0.0);
     vec3 p = voxel_center(voxel);
     float offset = 1.5 * gi.origin.w;
-    vec3 front = gather_diffuse(p + n * offset, n, 1.0);
-    vec3 back = gather_diffuse(p - n * offset, -n, 1.0);
-    vec3 gathered = luminance(front) >= luminance(back) ? front : back;
+    vec3 gathered = gather_diffuse(p + n * offset, n, 1.0);
     vec4 direct = imageLoad(voxel_direct, voxel);
     imageStore(voxel_radiance_out, voxel, vec4(direct.rgb + albedo.rgb / 255.0 * gathered, direct.a));
 }
