@@ -56,7 +56,8 @@ gpu_layout! {
         BINDING_GI_RADIANCE = 4;
         /// GI passes (set 2): voxel radiance, `sampler3D`.
         BINDING_GI_RADIANCE_SAMPLED = 5;
-        /// GI passes (set 2): the six directional mip volumes, `sampler3D[6]`.
+        /// GI passes (set 2): the six directional mip volumes side by side along x
+        /// (+X -X +Y -Y +Z -Z), `sampler3D`.
         BINDING_GI_DIRECTIONAL = 6;
         /// GI passes (set 2): screen radiance, read and added to, `rgba32f` storage.
         BINDING_GI_SCREEN = 7;
@@ -68,12 +69,14 @@ gpu_layout! {
         BINDING_GI_GBUFFER_DEPTH = 10;
         /// GI passes (set 2): voxel direct radiance (before bounces), `rgba16f` storage.
         BINDING_GI_DIRECT = 11;
-        /// filter pass (set 2): the level read, `rgba16f` storage `[6]` (+X -X +Y -Y +Z -Z).
-        BINDING_FILTER_SRC = 0;
-        /// filter pass (set 2): the level written, `rgba16f` storage `[6]`.
-        BINDING_FILTER_DST = 1;
+        /// filter pass (set 2): the base radiance, read by the first level, `rgba16f` storage.
+        BINDING_FILTER_BASE = 0;
+        /// filter pass (set 2): the directional level read (levels after the first), `rgba16f` storage.
+        BINDING_FILTER_SRC = 1;
+        /// filter pass (set 2): the directional level written, `rgba16f` storage.
+        BINDING_FILTER_DST = 2;
         /// filter pass (set 2): the voxel normals, oriented to the lit side by injection.
-        BINDING_FILTER_NORMAL = 2;
+        BINDING_FILTER_NORMAL = 3;
         /// Workgroup edge of the 3D compute passes.
         VOXEL_GROUP_SIZE = 4;
         /// Cones of the diffuse gather.

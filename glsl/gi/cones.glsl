@@ -6,19 +6,16 @@
 #include "gi/voxels.glsl"
 
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE_SAMPLED) uniform sampler3D voxel_radiance;
-layout(set = SET_PASS, binding = BINDING_GI_DIRECTIONAL) uniform sampler3D voxel_directional[6];
+layout(set = SET_PASS, binding = BINDING_GI_DIRECTIONAL) uniform sampler3D voxel_directional;
 
-// The directional volume facing a cone travelling along +axis (positive) or -axis.
-// Descriptor arrays are indexed by constants only: the sign differs between neighbouring
-// invocations, and non-uniform indexing is an optional feature lavapipe lacks (indexing
-// with it anyway gave 8x8-pixel blocks, one per workgroup).
-vec4 sample_directional(int axis, bool positive, vec3 uvw, float level) {
-    if (axis == 0) {
-        return positive ? textureLod(voxel_directional[0], uvw, level) : textureLod(voxel_directional[1], uvw, level);
-    } else if (axis == 1) {
-        return positive ? textureLod(voxel_directional[2], uvw, level) : textureLod(voxel_directional[3], uvw, level);
-    }
-    return positive ? textureLod(voxel_directional[4], uvw, level) : textureLod(voxel_directional[5], uvw, level);
+// The directional volume d (+X -X +Y -Y +Z -Z) at `uvw` and mip `level`. The six sit side
+// by side along x; x is kept half a texel (of the coarser level filtered) inside the
+// volume so that filtering never mixes two directions.
+vec4 sample_directional(int d, vec3 uvw, float level) {
+    float edge = float(max(int(gi.resolution) >> (int(ceil(level)) + 1), 1));
+    float margin = 0.5 / edge;
+    vec3 packed_uvw = vec3((float(d) + clamp(uvw.x, margin, 1.0 - margin)) / 6.0, uvw.yz);
+    return textureLod(voxel_directional, packed_uvw, level);
 }
 
 // Voxel radiance at `uvw` for a cone travelling along `dir` with footprint `lod` (0 = one
@@ -31,9 +28,9 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
     }
     vec3 w = dir * dir;
     float level = max(lod - 1.0, 0.0);
-    vec4 aniso = w.x * sample_directional(0, dir.x >= 0.0, uvw, level)
-        + w.y * sample_directional(1, dir.y >= 0.0, uvw, level)
-        + w.z * sample_directional(2, dir.z >= 0.0, uvw, level);
+    vec4 aniso = w.x * sample_directional(dir.x >= 0.0 ? 0 : 1, uvw, level)
+        + w.y * sample_directional(dir.y >= 0.0 ? 2 : 3, uvw, level)
+        + w.z * sample_directional(dir.z >= 0.0 ? 4 : 5, uvw, level);
     return lod < 1.0 ? mix(base, aniso, lod) : aniso;
 }
 

@@ -1,5 +1,5 @@
-//! Anisotropic filtering: the six directional mip chains of the voxel radiance, one
-//! compute dispatch per level.
+//! Anisotropic filtering: the six directional mip chains of the voxel radiance (side by
+//! side in one texture), one compute dispatch per level.
 
 use std::sync::Arc;
 
@@ -15,7 +15,7 @@ pub struct FilterPass {
     /// One set per level: level 0 reads the base volume, level k the directional level k-1.
     level_sets: Vec<vk::DescriptorSet>,
     _sets: DescriptorSets,
-    /// Per-level views of the directional volumes, referenced by the sets.
+    /// Per-level views of the directional texture, referenced by the sets.
     _views: Vec<OwnedView>,
 }
 
@@ -29,11 +29,12 @@ impl FilterPass {
         let storage = vk::DescriptorType::STORAGE_IMAGE;
         let compute = vk::ShaderStageFlags::COMPUTE;
         let bindings = [
-            Binding::new(layout::BINDING_FILTER_SRC, storage, compute).array(6),
-            Binding::new(layout::BINDING_FILTER_DST, storage, compute).array(6),
+            Binding::new(layout::BINDING_FILTER_BASE, storage, compute),
+            Binding::new(layout::BINDING_FILTER_SRC, storage, compute),
+            Binding::new(layout::BINDING_FILTER_DST, storage, compute),
             Binding::new(layout::BINDING_FILTER_NORMAL, storage, compute),
         ];
-        let levels = volumes.directional[0].desc.mip_levels;
+        let levels = volumes.directional.desc.mip_levels;
         let sets = DescriptorSets::new(ctx, "filter", &bindings, levels)?;
         let pipeline = Pipeline::compute(
             ctx,
@@ -42,35 +43,18 @@ impl FilterPass {
             &[set_layouts[0], set_layouts[1], sets.layout],
             4,
         )?;
-        let mut views = Vec::new();
-        for level in 0..levels {
-            for image in &volumes.directional {
-                views.push(image.layer_view(0, level)?);
-            }
-        }
-        let info = |view: vk::ImageView| vk::DescriptorImageInfo {
-            sampler: vk::Sampler::null(),
-            image_view: view,
-            image_layout: vk::ImageLayout::GENERAL,
-        };
+        let views = (0..levels)
+            .map(|level| volumes.directional.layer_view(0, level))
+            .collect::<Result<Vec<_>>>()?;
         let mut level_sets = Vec::new();
         for level in 0..levels as usize {
             let set = sets.allocate(&format!("filter level {level}"))?;
-            let src: Vec<_> = if level == 0 {
-                vec![info(volumes.radiance.view); 6]
-            } else {
-                views[(level - 1) * 6..level * 6]
-                    .iter()
-                    .map(|v| info(v.raw))
-                    .collect()
-            };
-            let dst = views[level * 6..(level + 1) * 6]
-                .iter()
-                .map(|v| info(v.raw))
-                .collect();
+            // The first level reads the base; it still needs some level bound as source.
+            let src = &views[level.saturating_sub(1)];
             SetWriter::new(ctx, set)
-                .images(layout::BINDING_FILTER_SRC, storage, src)
-                .images(layout::BINDING_FILTER_DST, storage, dst)
+                .storage_image(layout::BINDING_FILTER_BASE, volumes.radiance.view)
+                .storage_image(layout::BINDING_FILTER_SRC, src.raw)
+                .storage_image(layout::BINDING_FILTER_DST, views[level].raw)
                 .storage_image(layout::BINDING_FILTER_NORMAL, volumes.normal.view)
                 .apply();
             level_sets.push(set);

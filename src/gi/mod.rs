@@ -86,8 +86,10 @@ struct Volumes {
     radiance: Image,
     /// Direct light only, the starting point of each bounce.
     direct: Image,
-    /// +X -X +Y -Y +Z -Z, each resolution / 2 with a full mip chain.
-    directional: Vec<Image>,
+    /// +X -X +Y -Y +Z -Z side by side along x, each resolution / 2 with a full mip chain:
+    /// one texture, so that a cone picks its volume by coordinate (descriptor arrays need
+    /// constant indices on lavapipe, and branching over six textures costs twice as much).
+    directional: Image,
 }
 
 const PACKED_FORMAT: vk::Format = vk::Format::R32_UINT;
@@ -103,17 +105,10 @@ impl Volumes {
         let radiance_usage = vk::ImageUsageFlags::STORAGE
             | vk::ImageUsageFlags::SAMPLED
             | vk::ImageUsageFlags::TRANSFER_SRC;
-        let levels = n.trailing_zeros();
-        let directional = ["+x", "-x", "+y", "-y", "+z", "-z"]
-            .iter()
-            .map(|d| {
-                Image::new(
-                    ctx,
-                    &format!("voxel radiance {d}"),
-                    ImageDesc::d3(RADIANCE_FORMAT, n / 2, levels, radiance_usage),
-                )
-            })
-            .collect::<Result<_>>()?;
+        let mut directional_desc =
+            ImageDesc::d3(RADIANCE_FORMAT, n / 2, n.trailing_zeros(), radiance_usage);
+        directional_desc.extent.width = 6 * (n / 2);
+        let directional = Image::new(ctx, "voxel radiance directional", directional_desc)?;
         Ok(Self {
             albedo: packed("voxel albedo")?,
             normal: packed("voxel normal")?,
@@ -145,7 +140,7 @@ impl Volumes {
             ("voxel_direct", self.direct.memory_bytes()),
             (
                 "voxel_radiance_directional",
-                self.directional.iter().map(Image::memory_bytes).sum(),
+                self.directional.memory_bytes(),
             ),
         ]
     }
@@ -169,7 +164,7 @@ fn gi_bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_GI_EMISSION, storage, all),
         Binding::new(layout::BINDING_GI_RADIANCE, storage, all),
         Binding::new(layout::BINDING_GI_RADIANCE_SAMPLED, sampled, all),
-        Binding::new(layout::BINDING_GI_DIRECTIONAL, sampled, all).array(6),
+        Binding::new(layout::BINDING_GI_DIRECTIONAL, sampled, all),
         Binding::new(layout::BINDING_GI_SCREEN, storage, all),
         Binding::new(layout::BINDING_GI_GBUFFER_ALBEDO, storage, all),
         Binding::new(layout::BINDING_GI_GBUFFER_NORMAL, storage, all),
@@ -267,15 +262,6 @@ impl DenseGi {
                 .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
                 .max_lod(vk::LOD_CLAMP_NONE),
         )?;
-        let directional: Vec<_> = volumes
-            .directional
-            .iter()
-            .map(|image| vk::DescriptorImageInfo {
-                sampler: linear.raw,
-                image_view: image.view,
-                image_layout: vk::ImageLayout::GENERAL,
-            })
-            .collect();
         SetWriter::new(ctx, set)
             .buffer(
                 layout::BINDING_GI_UNIFORMS,
@@ -293,18 +279,16 @@ impl DenseGi {
                 linear.raw,
                 vk::ImageLayout::GENERAL,
             )
-            .images(
+            .sampled_image(
                 layout::BINDING_GI_DIRECTIONAL,
-                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                directional,
+                volumes.directional.view,
+                linear.raw,
+                vk::ImageLayout::GENERAL,
             )
             .apply();
         // The radiance volumes stay in GENERAL: written as storage, sampled by cones.
         OneShot::new(ctx)?.run("gi volume layouts", |cmd| {
-            for image in [&volumes.radiance, &volumes.direct]
-                .into_iter()
-                .chain(&volumes.directional)
-            {
+            for image in [&volumes.radiance, &volumes.direct, &volumes.directional] {
                 image_barrier(
                     ctx,
                     cmd,
@@ -456,9 +440,11 @@ impl DenseGi {
             Volume::Normal => &v.normal,
             Volume::Emission => &v.emission,
             Volume::Radiance => &v.radiance,
-            Volume::Directional(d) => &v.directional[d],
+            Volume::Directional(_) => &v.directional,
         };
-        let n = (image.desc.extent.width >> level).max(1);
+        // Edge of the level; the directional texture is six such cubes wide.
+        let n = (image.desc.extent.height >> level).max(1);
+        let width = (image.desc.extent.width >> level).max(1);
         let texel = if image.desc.format == PACKED_FORMAT {
             4
         } else {
@@ -467,7 +453,7 @@ impl DenseGi {
         let buffer = Buffer::new(
             &self.ctx,
             "volume readback",
-            u64::from(n).pow(3) * texel,
+            u64::from(width) * u64::from(n).pow(2) * texel,
             vk::BufferUsageFlags::TRANSFER_DST,
             gpu_allocator::MemoryLocation::GpuToCpu,
         )?;
@@ -505,7 +491,7 @@ impl DenseGi {
                 },
                 image_offset: vk::Offset3D::default(),
                 image_extent: vk::Extent3D {
-                    width: n,
+                    width,
                     height: n,
                     depth: n,
                 },
@@ -538,7 +524,19 @@ impl DenseGi {
             );
             Ok(())
         })?;
-        Ok(buffer.mapped().to_vec())
+        let bytes = buffer.mapped();
+        Ok(match volume {
+            // Direction d's cube: the d-th run of n texels in every row.
+            Volume::Directional(d) => {
+                let row = n as usize * texel as usize;
+                bytes
+                    .chunks_exact(width as usize * texel as usize)
+                    .flat_map(|r| &r[d * row..(d + 1) * row])
+                    .copied()
+                    .collect()
+            }
+            _ => bytes.to_vec(),
+        })
     }
 }
 

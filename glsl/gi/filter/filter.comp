@@ -2,12 +2,14 @@
 // One level of the anisotropic mip chain (Crassin 2011; Dřínovský 2013 §5.5): for each
 // direction a cone can travel (+X -X +Y -Y +Z -Z), the 2x2x2 children are composited
 // front to back along that axis in pairs and the four pairs averaged. Values are
-// premultiplied by opacity. The first level reads the isotropic base in all six slots.
+// premultiplied by opacity. The first level reads the isotropic base; the six directions
+// sit side by side along x, direction d's cube at x offset d * edge.
 #include "gpu_layout.glsl"
 
 layout(local_size_x = VOXEL_GROUP_SIZE, local_size_y = VOXEL_GROUP_SIZE, local_size_z = VOXEL_GROUP_SIZE) in;
-layout(set = SET_PASS, binding = BINDING_FILTER_SRC, rgba16f) uniform readonly image3D src[6];
-layout(set = SET_PASS, binding = BINDING_FILTER_DST, rgba16f) uniform writeonly image3D dst[6];
+layout(set = SET_PASS, binding = BINDING_FILTER_BASE, rgba16f) uniform readonly image3D base_level;
+layout(set = SET_PASS, binding = BINDING_FILTER_SRC, rgba16f) uniform readonly image3D src;
+layout(set = SET_PASS, binding = BINDING_FILTER_DST, rgba16f) uniform writeonly image3D dst;
 layout(set = SET_PASS, binding = BINDING_FILTER_NORMAL, r32ui) uniform readonly uimage3D voxel_normal;
 layout(push_constant) uniform FilterPush {
     uint level;
@@ -34,44 +36,37 @@ vec4 over(vec4 front, vec4 back) {
     return front + (1.0 - front.a) * back;
 }
 
-// One direction D (a literal: descriptor arrays take constant indices only, dynamic
-// indexing being an optional feature lavapipe lacks).
-#define FILTER_DIRECTION(D)                                                   \
-    {                                                                         \
-        int axis = D / 2;                                                     \
-        /* Travelling along +axis meets the child at offset 0 first. */       \
-        int front = (D % 2 == 0) ? 0 : 1;                                     \
-        vec4 sum = vec4(0.0);                                                 \
-        for (int u = 0; u < 2; u++) {                                         \
-            for (int v = 0; v < 2; v++) {                                     \
-                ivec3 f = ivec3(0);                                           \
-                f[(axis + 1) % 3] = u;                                        \
-                f[(axis + 2) % 3] = v;                                        \
-                ivec3 b = f;                                                  \
-                f[axis] = front;                                              \
-                b[axis] = 1 - front;                                          \
-                vec4 fv = imageLoad(src[D], base + f);                        \
-                vec4 bv = imageLoad(src[D], base + b);                        \
-                if (level == 0u) {                                            \
-                    fv = facing(base + f, fv, D);                             \
-                    bv = facing(base + b, bv, D);                             \
-                }                                                             \
-                sum += over(fv, bv);                                          \
-            }                                                                 \
-        }                                                                     \
-        imageStore(dst[D], parent, sum * 0.25);                               \
+// Child voxel `child` (cube coordinates at the level below) as seen along direction d.
+vec4 load(ivec3 child, int d, int child_edge) {
+    if (level == 0u) {
+        return facing(child, imageLoad(base_level, child), d);
     }
+    return imageLoad(src, child + ivec3(d * child_edge, 0, 0));
+}
 
 void main() {
+    int edge = imageSize(dst).y;
     ivec3 parent = ivec3(gl_GlobalInvocationID);
-    if (any(greaterThanEqual(parent, imageSize(dst[0])))) {
+    if (any(greaterThanEqual(parent, ivec3(edge)))) {
         return;
     }
-    ivec3 base = parent * 2;
-    FILTER_DIRECTION(0)
-    FILTER_DIRECTION(1)
-    FILTER_DIRECTION(2)
-    FILTER_DIRECTION(3)
-    FILTER_DIRECTION(4)
-    FILTER_DIRECTION(5)
+    ivec3 first = parent * 2;
+    for (int d = 0; d < 6; d++) {
+        int axis = d / 2;
+        // Travelling along +axis meets the child at offset 0 first.
+        int front = (d % 2 == 0) ? 0 : 1;
+        vec4 sum = vec4(0.0);
+        for (int u = 0; u < 2; u++) {
+            for (int v = 0; v < 2; v++) {
+                ivec3 f = ivec3(0);
+                f[(axis + 1) % 3] = u;
+                f[(axis + 2) % 3] = v;
+                ivec3 b = f;
+                f[axis] = front;
+                b[axis] = 1 - front;
+                sum += over(load(first + f, d, edge * 2), load(first + b, d, edge * 2));
+            }
+        }
+        imageStore(dst, parent + ivec3(d * edge, 0, 0), sum * 0.25);
+    }
 }
