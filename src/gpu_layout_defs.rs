@@ -18,13 +18,12 @@ gpu_layout! {
 
         /// set 1: `GpuMaterial[]` storage buffer.
         BINDING_MATERIALS = 0;
-        /// set 1: `texture2D textures[MAX_TEXTURES]`.
-        BINDING_TEXTURES = 1;
-        /// set 1: the `sampler` for material textures.
-        BINDING_MATERIAL_SAMPLER = 2;
-        /// Size of the texture array; unused slots hold a 1x1 white texture. Lavapipe
-        /// allows 128 sampled images per stage, and passes need a few of their own.
-        MAX_TEXTURES = 96;
+        /// set 1 (one set per material): albedo texture, `sampler2D` (white if none).
+        BINDING_ALBEDO_TEXTURE = 1;
+        /// set 1: cut-out coverage texture, `sampler2D` (white if none).
+        BINDING_COVERAGE_TEXTURE = 2;
+        /// set 1: tangent-space normal map, `sampler2D` (white if none).
+        BINDING_NORMAL_TEXTURE = 3;
         /// A material's texture index meaning "no texture".
         NO_TEXTURE = 0xFFFFFFFF;
 
@@ -164,7 +163,7 @@ gpu_layout! {
         vec4 specular,
         /// rgb emitted radiance, a index of refraction.
         vec4 emission,
-        /// Albedo texture or `NO_TEXTURE`.
+        /// Index of the albedo texture, or `NO_TEXTURE`.
         uint albedo_texture,
         /// Cut-out coverage texture or `NO_TEXTURE`.
         uint coverage_texture,

@@ -439,10 +439,7 @@ impl Renderer {
         let draw = SceneDraw {
             scene: &self.scene,
             gpu: &self.gpu,
-            sets: [
-                (layout::SET_FRAME, data.set),
-                (layout::SET_SCENE, self.gpu.set),
-            ],
+            frame_set: data.set,
             time_s,
         };
         let timer = &mut data.timer;

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use ash::vk;
 
 use crate::gpu_layout::{self as layout, DrawPush, GpuMaterial};
@@ -17,8 +17,8 @@ use crate::vk::{
 pub struct SceneDraw<'a> {
     pub scene: &'a crate::scene::Scene,
     pub gpu: &'a GpuScene,
-    /// The frame and scene descriptor sets.
-    pub sets: [(u32, vk::DescriptorSet); 2],
+    /// The frame's descriptor set (set 0).
+    pub frame_set: vk::DescriptorSet,
     pub time_s: f32,
 }
 
@@ -34,7 +34,7 @@ impl SceneDraw<'_> {
         shadow_view: u32,
         pass_set: Option<vk::DescriptorSet>,
     ) {
-        pipeline.bind(cmd, &self.sets);
+        pipeline.bind(cmd, &[(layout::SET_FRAME, self.frame_set)]);
         if let Some(set) = pass_set {
             pipeline.bind_set(cmd, layout::SET_PASS, set);
         }
@@ -49,6 +49,11 @@ impl SceneDraw<'_> {
                 shadow_view,
                 ..Default::default()
             };
+            pipeline.bind_set(
+                cmd,
+                layout::SET_SCENE,
+                self.gpu.material_sets[draw.material as usize],
+            );
             pipeline.push(
                 cmd,
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
@@ -83,7 +88,9 @@ pub struct GpuScene {
     pub indices: Buffer,
     pub materials: Buffer,
     pub draws: Vec<Draw>,
-    pub set: vk::DescriptorSet,
+    /// Set 1 of each material: the material buffer and its textures.
+    material_sets: Vec<vk::DescriptorSet>,
+    /// The layout of set 1, and the pool the material sets come from.
     pub sets: DescriptorSets,
     textures: Vec<Image>,
     sampler: Sampler,
@@ -101,36 +108,22 @@ fn texture_index(index: Option<u32>) -> u32 {
 }
 
 impl GpuScene {
-    pub fn bindings() -> [Binding; 3] {
+    pub fn bindings() -> [Binding; 4] {
         let stages = vk::ShaderStageFlags::ALL;
+        let sampled = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
         [
             Binding::new(
                 layout::BINDING_MATERIALS,
                 vk::DescriptorType::STORAGE_BUFFER,
                 stages,
             ),
-            Binding::new(
-                layout::BINDING_TEXTURES,
-                vk::DescriptorType::SAMPLED_IMAGE,
-                stages,
-            )
-            .array(layout::MAX_TEXTURES),
-            Binding::new(
-                layout::BINDING_MATERIAL_SAMPLER,
-                vk::DescriptorType::SAMPLER,
-                stages,
-            ),
+            Binding::new(layout::BINDING_ALBEDO_TEXTURE, sampled, stages),
+            Binding::new(layout::BINDING_COVERAGE_TEXTURE, sampled, stages),
+            Binding::new(layout::BINDING_NORMAL_TEXTURE, sampled, stages),
         ]
     }
 
     pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<Self> {
-        if scene.textures.len() >= layout::MAX_TEXTURES as usize {
-            bail!(
-                "the scene has {} textures; at most {} are supported",
-                scene.textures.len(),
-                layout::MAX_TEXTURES - 1
-            );
-        }
         let one_shot = OneShot::new(ctx)?;
         let mut vertices: Vec<Vertex> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
@@ -230,35 +223,55 @@ impl GpuScene {
                 .max_anisotropy(max_anisotropy)
                 .max_lod(vk::LOD_CLAMP_NONE),
         )?;
-        let sets = DescriptorSets::new(ctx, "scene", &Self::bindings(), 1)?;
-        let set = sets.allocate("scene")?;
-        let image_infos: Vec<_> = (0..layout::MAX_TEXTURES as usize)
-            .map(|i| vk::DescriptorImageInfo {
-                sampler: vk::Sampler::null(),
-                image_view: textures.get(i).unwrap_or(&white).view,
-                image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        let sets = DescriptorSets::new(
+            ctx,
+            "materials",
+            &Self::bindings(),
+            scene.materials.len().max(1) as u32,
+        )?;
+        let texture_view =
+            |index: Option<u32>| index.map_or(white.view, |i| textures[i as usize].view);
+        let material_sets = scene
+            .materials
+            .iter()
+            .map(|m| {
+                let set = sets.allocate(&format!("material {}", m.name))?;
+                let layout_ro = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+                SetWriter::new(ctx, set)
+                    .buffer(
+                        layout::BINDING_MATERIALS,
+                        vk::DescriptorType::STORAGE_BUFFER,
+                        materials.raw,
+                    )
+                    .sampled_image(
+                        layout::BINDING_ALBEDO_TEXTURE,
+                        texture_view(m.albedo_texture),
+                        sampler.raw,
+                        layout_ro,
+                    )
+                    .sampled_image(
+                        layout::BINDING_COVERAGE_TEXTURE,
+                        texture_view(m.coverage_texture),
+                        sampler.raw,
+                        layout_ro,
+                    )
+                    .sampled_image(
+                        layout::BINDING_NORMAL_TEXTURE,
+                        texture_view(m.normal_texture),
+                        sampler.raw,
+                        layout_ro,
+                    )
+                    .apply();
+                Ok(set)
             })
-            .collect();
-        SetWriter::new(ctx, set)
-            .buffer(
-                layout::BINDING_MATERIALS,
-                vk::DescriptorType::STORAGE_BUFFER,
-                materials.raw,
-            )
-            .images(
-                layout::BINDING_TEXTURES,
-                vk::DescriptorType::SAMPLED_IMAGE,
-                image_infos,
-            )
-            .sampler(layout::BINDING_MATERIAL_SAMPLER, sampler.raw)
-            .apply();
+            .collect::<Result<Vec<_>>>()?;
         textures.push(white);
         Ok(Self {
             vertices,
             indices,
             materials,
             draws,
-            set,
+            material_sets,
             sets,
             textures,
             sampler,

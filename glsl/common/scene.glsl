@@ -6,21 +6,17 @@
 layout(set = SET_SCENE, binding = BINDING_MATERIALS, std430) readonly buffer MaterialBlock {
     GpuMaterial materials[];
 };
-// Separate images and one sampler: combined image samplers count against a limit of
-// 32 samplers per stage on lavapipe.
-layout(set = SET_SCENE, binding = BINDING_TEXTURES) uniform texture2D textures[MAX_TEXTURES];
-layout(set = SET_SCENE, binding = BINDING_MATERIAL_SAMPLER) uniform sampler material_sampler;
+// The drawn material's textures: one descriptor set per material, so that shaders index
+// no texture arrays (dynamic indexing is an optional feature that lavapipe lacks).
+layout(set = SET_SCENE, binding = BINDING_ALBEDO_TEXTURE) uniform sampler2D albedo_texture;
+layout(set = SET_SCENE, binding = BINDING_COVERAGE_TEXTURE) uniform sampler2D coverage_texture;
+layout(set = SET_SCENE, binding = BINDING_NORMAL_TEXTURE) uniform sampler2D normal_texture;
 
-vec4 sample_texture(uint index, vec2 uv) {
-    return texture(sampler2D(textures[index], material_sampler), uv);
-}
-
-// Kd x map_Kd. The material index is uniform per draw, so indexing the array needs no
-// non-uniform qualifier.
+// Kd x map_Kd.
 vec3 material_albedo(GpuMaterial m, vec2 uv) {
     vec3 albedo = m.albedo.rgb;
     if (m.albedo_texture != NO_TEXTURE) {
-        albedo *= sample_texture(m.albedo_texture, uv).rgb;
+        albedo *= texture(albedo_texture, uv).rgb;
     }
     return albedo;
 }
@@ -29,7 +25,7 @@ vec3 material_albedo(GpuMaterial m, vec2 uv) {
 float material_coverage(GpuMaterial m, vec2 uv) {
     float coverage = m.albedo.a;
     if (m.coverage_texture != NO_TEXTURE) {
-        coverage *= sample_texture(m.coverage_texture, uv).r;
+        coverage *= texture(coverage_texture, uv).r;
     }
     return coverage;
 }

@@ -14,7 +14,7 @@ layout(location = 2) out vec4 out_emission; // rgb emitted radiance
 // Perturbs n by a tangent-space normal map with a cotangent frame from screen-space
 // derivatives (Schüler, "Normal mapping without precomputed tangents"), so meshes need
 // no tangents.
-vec3 apply_normal_map(vec3 n, uint map) {
+vec3 apply_normal_map(vec3 n) {
     vec3 dp1 = dFdx(in_world);
     vec3 dp2 = dFdy(in_world);
     vec2 duv1 = dFdx(in_uv);
@@ -28,7 +28,7 @@ vec3 apply_normal_map(vec3 n, uint map) {
         return n;
     }
     float scale = inversesqrt(len);
-    vec3 m = sample_texture(map, in_uv).xyz * 2.0 - 1.0;
+    vec3 m = texture(normal_texture, in_uv).xyz * 2.0 - 1.0;
     // Our v runs down the image (Vertex.uv), the map's green axis runs up it.
     m.y = -m.y;
     vec3 mapped = normalize(mat3(t * scale, b * scale, n) * m);
@@ -48,7 +48,7 @@ void main() {
         n = -n;
     }
     if ((frame.flags & FLAG_NORMAL_MAPS) != 0u && m.normal_texture != NO_TEXTURE) {
-        n = apply_normal_map(n, m.normal_texture);
+        n = apply_normal_map(n);
     }
     float specular = (frame.flags & FLAG_SPECULAR) != 0u ? dot(m.specular.rgb, vec3(1.0 / 3.0)) : 0.0;
     out_albedo = vec4(material_albedo(m, in_uv), specular);

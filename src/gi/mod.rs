@@ -397,7 +397,7 @@ impl DenseGi {
         // Last frame's cone tracing sampled the radiance volumes that are rewritten now.
         compute_to_compute(ctx, cmd);
         self.inject
-            .record(ctx, cmd, draw.sets[0].1, self.set, self.grid.resolution);
+            .record(ctx, cmd, draw.frame_set, self.set, self.grid.resolution);
         timer.end(cmd);
 
         timer.begin(cmd, "filter");
@@ -409,7 +409,7 @@ impl DenseGi {
             timer.begin(cmd, "bounce");
             compute_to_compute(ctx, cmd);
             self.inject
-                .record_bounce(ctx, cmd, draw.sets[0].1, self.set, self.grid.resolution);
+                .record_bounce(ctx, cmd, draw.frame_set, self.set, self.grid.resolution);
             compute_to_compute(ctx, cmd);
             self.filter.record(ctx, cmd, self.grid.resolution);
             timer.end(cmd);
