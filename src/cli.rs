@@ -75,6 +75,13 @@ pub struct CommonArgs {
     /// Voxels per axis of the dense grid (a power of two).
     #[arg(long, default_value_t = 64)]
     pub voxels: u32,
+    /// Trace indirect light on one pixel of each NxN block and upsample (1: every pixel).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
+    pub indirect_scale: u32,
+    /// Recompute every bounce every frame, instead of adding one bounce per frame to the
+    /// last frame's light (the first frame always computes them all).
+    #[arg(long)]
+    pub no_accumulate: bool,
     /// Light bounces between voxels (1: direct light on the voxels only).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub bounces: u32,
@@ -197,6 +204,8 @@ impl CommonArgs {
                 voxels: self.voxels,
                 cones: ConeSettings {
                     bounces: self.bounces,
+                    indirect_scale: self.indirect_scale,
+                    accumulate_bounces: !self.no_accumulate,
                     ..ConeSettings::default()
                 },
             }),

@@ -68,6 +68,8 @@ gpu_layout! {
         BINDING_GI_GBUFFER_DEPTH = 10;
         /// GI passes (set 2): voxel direct radiance (before bounces), `rgba16f` storage.
         BINDING_GI_DIRECT = 11;
+        /// GI passes (set 2): gathered indirect radiance at reduced resolution, `rgba16f` storage.
+        BINDING_GI_INDIRECT = 12;
         /// filter pass (set 2): the base radiance, read by the first level, `rgba16f` storage.
         BINDING_FILTER_BASE = 0;
         /// filter pass (set 2): the directional level read (levels after the first), `rgba16f` storage.
@@ -189,8 +191,8 @@ gpu_layout! {
         float diffuse_tan_half,
         /// Cones stop after this distance in world units.
         float max_distance,
-        /// Unused.
-        float pad0,
+        /// Indirect light is traced on one pixel of each `indirect_scale`² block.
+        uint indirect_scale,
         /// Unused.
         float pad1,
     }

@@ -258,7 +258,7 @@ impl Renderer {
             });
         }
         let targets = Self::create_targets(ctx, extent)?;
-        let renderer = Self {
+        let mut renderer = Self {
             camera: scene.camera.clone(),
             scene,
             settings,
@@ -279,7 +279,7 @@ impl Renderer {
             _shadow_sampler: shadow_sampler,
             ctx: ctx.clone(),
         };
-        renderer.bind_targets();
+        renderer.bind_targets()?;
         Ok(renderer)
     }
 
@@ -290,15 +290,16 @@ impl Renderer {
         })
     }
 
-    fn bind_targets(&self) {
+    fn bind_targets(&mut self) -> Result<()> {
         let t = &self.targets;
         self.lighting
             .bind_targets(&self.ctx, &t.gbuffer, &t.radiance, self.nearest_sampler.raw);
         self.composite
             .bind_input(&self.ctx, &t.radiance, self.nearest_sampler.raw);
-        if let Some(gi) = &self.gi {
-            gi.bind_screen(&t.gbuffer, &t.radiance, self.nearest_sampler.raw);
+        if let Some(gi) = &mut self.gi {
+            gi.bind_screen(&t.gbuffer, &t.radiance, self.nearest_sampler.raw)?;
         }
+        Ok(())
     }
 
     pub fn context(&self) -> &Arc<Context> {
@@ -334,8 +335,7 @@ impl Renderer {
         self.ctx.wait_idle()?;
         self.targets = Self::create_targets(&self.ctx, extent)?;
         self.radiance_last_use = ImageUse::FRAGMENT_READ;
-        self.bind_targets();
-        Ok(())
+        self.bind_targets()
     }
 
     fn frame_uniforms(&self, time_s: f32) -> FrameUniforms {
@@ -465,7 +465,7 @@ impl Renderer {
             .record(&ctx, cmd, &self.targets.gbuffer, &draw);
         timer.end(cmd);
 
-        if let Some(gi) = &self.gi {
+        if let Some(gi) = &mut self.gi {
             gi.record_update(cmd, timer, &draw);
         }
 

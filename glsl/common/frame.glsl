@@ -15,4 +15,11 @@ layout(set = SET_FRAME, binding = BINDING_SHADOW_VIEWS, std430) readonly buffer 
 layout(set = SET_FRAME, binding = BINDING_SHADOW_MAP) uniform sampler2DArrayShadow shadow_map;
 
 const float PI = 3.14159265358979;
+
+// World position of the surface seen through `pixel` at depth-buffer value `depth`.
+vec3 pixel_position(ivec2 pixel, float depth) {
+    vec2 ndc = (vec2(pixel) + 0.5) / vec2(frame.width, frame.height) * 2.0 - 1.0;
+    vec4 world = frame.inv_view_proj * vec4(ndc, depth, 1.0);
+    return world.xyz / world.w;
+}
 #endif

@@ -10,12 +10,6 @@ layout(set = SET_PASS, binding = BINDING_LIGHTING_EMISSION, rgba16f) uniform rea
 layout(set = SET_PASS, binding = BINDING_LIGHTING_DEPTH) uniform sampler2D gbuffer_depth;
 layout(set = SET_PASS, binding = BINDING_LIGHTING_OUT, rgba32f) uniform writeonly image2D radiance_out;
 
-vec3 world_position(ivec2 pixel, float depth) {
-    vec2 ndc = (vec2(pixel) + 0.5) / vec2(frame.width, frame.height) * 2.0 - 1.0;
-    vec4 world = frame.inv_view_proj * vec4(ndc, depth, 1.0);
-    return world.xyz / world.w;
-}
-
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (pixel.x >= int(frame.width) || pixel.y >= int(frame.height)) {
@@ -28,7 +22,7 @@ void main() {
     }
     vec4 albedo = imageLoad(gbuffer_albedo, pixel);
     vec4 normal_roughness = imageLoad(gbuffer_normal, pixel);
-    vec3 p = world_position(pixel, depth);
+    vec3 p = pixel_position(pixel, depth);
     vec3 n = normalize(normal_roughness.xyz);
     vec3 v = normalize(frame.camera_position.xyz - p);
     // Normalised Blinn-Phong with the exponent matching the roughness.

@@ -1,4 +1,5 @@
-//! Cone tracing: indirect diffuse light per G-buffer pixel, added to the direct light.
+//! Cone tracing: indirect diffuse light gathered at reduced resolution, then upsampled
+//! (depth- and normal-aware) and added to the direct light.
 
 use std::sync::Arc;
 
@@ -10,6 +11,7 @@ use crate::vk::{groups, Context, Pipeline};
 
 pub struct ConeTracePass {
     pipeline: Pipeline,
+    upsample: Pipeline,
 }
 
 impl ConeTracePass {
@@ -22,10 +24,30 @@ impl ConeTracePass {
             &set_layouts,
             0,
         )?;
-        Ok(Self { pipeline })
+        let upsample = Pipeline::compute(
+            ctx,
+            "upsample",
+            crate::vk::shaders::GI_CONE_TRACE_UPSAMPLE_COMP,
+            &set_layouts,
+            0,
+        )?;
+        Ok(Self { pipeline, upsample })
     }
 
+    /// Gathers at the reduced resolution `low`.
     pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        frame_set: vk::DescriptorSet,
+        gi_set: vk::DescriptorSet,
+        low: vk::Extent2D,
+    ) {
+        dispatch_screen(ctx, cmd, &self.pipeline, frame_set, gi_set, low);
+    }
+
+    /// Adds the upsampled indirect light to every pixel of `extent`.
+    pub fn record_upsample(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
@@ -33,17 +55,28 @@ impl ConeTracePass {
         gi_set: vk::DescriptorSet,
         extent: vk::Extent2D,
     ) {
-        self.pipeline.bind(
-            cmd,
-            &[(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)],
-        );
-        unsafe {
-            ctx.device.cmd_dispatch(
-                cmd,
-                groups(extent.width, layout::SCREEN_GROUP_SIZE),
-                groups(extent.height, layout::SCREEN_GROUP_SIZE),
-                1,
-            )
-        };
+        dispatch_screen(ctx, cmd, &self.upsample, frame_set, gi_set, extent);
     }
+}
+
+fn dispatch_screen(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    pipeline: &Pipeline,
+    frame_set: vk::DescriptorSet,
+    gi_set: vk::DescriptorSet,
+    extent: vk::Extent2D,
+) {
+    pipeline.bind(
+        cmd,
+        &[(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)],
+    );
+    unsafe {
+        ctx.device.cmd_dispatch(
+            cmd,
+            groups(extent.width, layout::SCREEN_GROUP_SIZE),
+            groups(extent.height, layout::SCREEN_GROUP_SIZE),
+            1,
+        )
+    };
 }

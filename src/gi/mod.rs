@@ -66,6 +66,11 @@ pub struct ConeSettings {
     pub step_factor: f32,
     /// Light bounces between voxels: 1 is direct light on the voxels only.
     pub bounces: u32,
+    /// Indirect light is traced on one pixel of each `indirect_scale`² block and
+    /// upsampled.
+    pub indirect_scale: u32,
+    /// After the first frame, add one bounce per frame on top of the last frame's.
+    pub accumulate_bounces: bool,
 }
 
 impl Default for ConeSettings {
@@ -74,6 +79,8 @@ impl Default for ConeSettings {
             diffuse_aperture_deg: 60.0,
             step_factor: 0.5,
             bounces: 4,
+            indirect_scale: 2,
+            accumulate_bounces: true,
         }
     }
 }
@@ -170,6 +177,7 @@ fn gi_bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_GI_GBUFFER_NORMAL, storage, all),
         Binding::new(layout::BINDING_GI_GBUFFER_DEPTH, sampled, all),
         Binding::new(layout::BINDING_GI_DIRECT, storage, all),
+        Binding::new(layout::BINDING_GI_INDIRECT, storage, all),
     ]
 }
 
@@ -194,6 +202,12 @@ pub struct DenseGi {
     voxelize: voxelize::VoxelizePass,
     inject: inject::InjectPass,
     bounces: u32,
+    accumulate_bounces: bool,
+    /// The directional volumes hold last frame's result (with its bounces).
+    history: bool,
+    indirect_scale: u32,
+    /// Gathered indirect light at reduced resolution (created with the screen targets).
+    indirect: Option<Image>,
     filter: filter::FilterPass,
     cone_trace: cone_trace::ConeTracePass,
     set: vk::DescriptorSet,
@@ -238,6 +252,7 @@ impl DenseGi {
             step_factor: cones.step_factor,
             diffuse_tan_half: (cones.diffuse_aperture_deg.to_radians() * 0.5).tan(),
             max_distance: grid.voxel_size * resolution as f32 * 1.8,
+            indirect_scale: cones.indirect_scale.max(1),
             ..Default::default()
         };
         let uniforms = Buffer::with_data(
@@ -309,6 +324,10 @@ impl DenseGi {
             )?,
             inject: inject::InjectPass::new(ctx, [set_layouts[0], set_layouts[1], gi_layout])?,
             bounces: cones.bounces.max(1),
+            accumulate_bounces: cones.accumulate_bounces && cones.bounces > 1,
+            history: false,
+            indirect_scale: cones.indirect_scale.max(1),
+            indirect: None,
             filter: filter::FilterPass::new(ctx, set_layouts, &volumes)?,
             cone_trace: cone_trace::ConeTracePass::new(
                 ctx,
@@ -325,8 +344,36 @@ impl DenseGi {
 
     /// Points the cone tracer at new screen targets; no frame using the old ones may be
     /// in flight.
-    pub fn bind_screen(&self, gbuffer: &GBuffer, radiance: &Image, depth_sampler: vk::Sampler) {
+    pub fn bind_screen(
+        &mut self,
+        gbuffer: &GBuffer,
+        radiance: &Image,
+        depth_sampler: vk::Sampler,
+    ) -> Result<()> {
+        let extent = gbuffer.extent();
+        let indirect = Image::new(
+            &self.ctx,
+            "indirect",
+            ImageDesc::d2(
+                RADIANCE_FORMAT,
+                extent.width.div_ceil(self.indirect_scale),
+                extent.height.div_ceil(self.indirect_scale),
+                vk::ImageUsageFlags::STORAGE,
+            ),
+        )?;
+        OneShot::new(&self.ctx)?.run("indirect layout", |cmd| {
+            image_barrier(
+                &self.ctx,
+                cmd,
+                indirect.raw,
+                indirect.full_range(),
+                ImageUse::UNDEFINED,
+                ImageUse::COMPUTE_WRITE,
+            );
+            Ok(())
+        })?;
         SetWriter::new(&self.ctx, self.set)
+            .storage_image(layout::BINDING_GI_INDIRECT, indirect.view)
             .storage_image(layout::BINDING_GI_SCREEN, radiance.view)
             .storage_image(layout::BINDING_GI_GBUFFER_ALBEDO, gbuffer.albedo.view)
             .storage_image(layout::BINDING_GI_GBUFFER_NORMAL, gbuffer.normal.view)
@@ -337,6 +384,8 @@ impl DenseGi {
                 vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
             )
             .apply();
+        self.indirect = Some(indirect);
+        Ok(())
     }
 
     /// GPU memory of every voxel volume, by name.
@@ -345,7 +394,16 @@ impl DenseGi {
     }
 
     /// Voxelizes the scene and lights and filters the voxels (after the shadow maps).
-    pub fn record_update(&self, cmd: vk::CommandBuffer, timer: &mut GpuTimer, draw: &SceneDraw) {
+    ///
+    /// The first frame computes all bounces. Later frames compute one, gathering from the
+    /// previous frame's filtered radiance, so bounces accumulate over frames at the cost
+    /// of one (moving light takes a few frames to settle in the indirect light).
+    pub fn record_update(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
+        draw: &SceneDraw,
+    ) {
         let ctx = &self.ctx;
         timer.begin(cmd, "voxelize");
         for image in self.volumes.packed() {
@@ -400,12 +458,15 @@ impl DenseGi {
             .record(ctx, cmd, draw.frame_set, self.set, self.grid.resolution);
         timer.end(cmd);
 
-        timer.begin(cmd, "filter");
-        compute_to_compute(ctx, cmd);
-        self.filter.record(ctx, cmd, self.grid.resolution);
-        timer.end(cmd);
-
-        for _ in 1..self.bounces {
+        let bounces = if self.history { 1 } else { self.bounces - 1 };
+        if !self.history {
+            timer.begin(cmd, "filter");
+            compute_to_compute(ctx, cmd);
+            self.filter.record(ctx, cmd, self.grid.resolution);
+            timer.end(cmd);
+        }
+        self.history = self.accumulate_bounces;
+        for _ in 0..bounces {
             timer.begin(cmd, "bounce");
             compute_to_compute(ctx, cmd);
             self.inject
@@ -426,8 +487,19 @@ impl DenseGi {
     ) {
         timer.begin(cmd, "cone_trace");
         compute_to_compute(&self.ctx, cmd);
+        let scale = self.indirect_scale;
+        let low = vk::Extent2D {
+            width: extent.width.div_ceil(scale),
+            height: extent.height.div_ceil(scale),
+        };
         self.cone_trace
-            .record(&self.ctx, cmd, frame_set, self.set, extent);
+            .record(&self.ctx, cmd, frame_set, self.set, low);
+        timer.end(cmd);
+
+        timer.begin(cmd, "upsample");
+        compute_to_compute(&self.ctx, cmd);
+        self.cone_trace
+            .record_upsample(&self.ctx, cmd, frame_set, self.set, extent);
         timer.end(cmd);
     }
 

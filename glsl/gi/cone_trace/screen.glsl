@@ -1,0 +1,16 @@
+// G-buffer access for the screen-space GI passes.
+#ifndef SCREEN_GLSL
+#define SCREEN_GLSL
+#include "common/frame.glsl"
+#include "gi/voxels.glsl"
+
+layout(set = SET_PASS, binding = BINDING_GI_GBUFFER_ALBEDO, rgba16f) uniform readonly image2D gbuffer_albedo;
+layout(set = SET_PASS, binding = BINDING_GI_GBUFFER_NORMAL, rgba16f) uniform readonly image2D gbuffer_normal;
+layout(set = SET_PASS, binding = BINDING_GI_GBUFFER_DEPTH) uniform sampler2D gbuffer_depth;
+
+// The full-resolution pixel that stands for reduced-resolution pixel `low`.
+ivec2 representative(ivec2 low) {
+    ivec2 full = low * int(gi.indirect_scale) + int(gi.indirect_scale) / 2;
+    return min(full, ivec2(frame.width, frame.height) - 1);
+}
+#endif
