@@ -36,9 +36,9 @@ pub enum Command {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum GiMode {
     /// Direct light only.
-    #[default]
     Off,
     /// Voxel cone tracing on a dense voxel grid in 3D textures.
+    #[default]
     Dense,
 }
 
@@ -48,7 +48,7 @@ pub struct CommonArgs {
     /// (default: the built-in Cornell box).
     pub scene: Option<PathBuf>,
     /// Global illumination method.
-    #[arg(long, value_enum, default_value_t = GiMode::Off)]
+    #[arg(long, value_enum, default_value_t = GiMode::Dense)]
     pub gi: GiMode,
     /// Enable the Vulkan validation layer (with synchronization validation); any message
     /// makes the command fail. Also on when VOXCONE_VALIDATION=1.

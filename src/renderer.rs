@@ -112,6 +112,8 @@ pub struct Renderer {
     gbuffer_pass: GBufferPass,
     shadow: ShadowPass,
     gi: Option<DenseGi>,
+    /// Whether the GI passes run (the viewer's toggle).
+    indirect: bool,
     /// Light views and mesh transforms the shadow maps were last rendered with.
     shadow_inputs: Option<Vec<[[f32; 4]; 4]>>,
     frames: Vec<FrameData>,
@@ -270,6 +272,7 @@ impl Renderer {
             gbuffer_pass,
             shadow,
             gi,
+            indirect: true,
             shadow_inputs: None,
             frames,
             _frame_sets: frame_sets,
@@ -308,6 +311,20 @@ impl Renderer {
 
     pub fn extent(&self) -> vk::Extent2D {
         self.targets.gbuffer.extent()
+    }
+
+    /// Turns the indirect light on or off (when the renderer has GI); returns whether it
+    /// is on now.
+    pub fn toggle_indirect(&mut self) -> bool {
+        match &mut self.gi {
+            Some(gi) => {
+                self.indirect = !self.indirect;
+                // Bounces accumulated before the pause may no longer match the scene.
+                gi.restart();
+                self.indirect
+            }
+            None => false,
+        }
     }
 
     /// The dense voxel GI, when enabled.
@@ -465,7 +482,8 @@ impl Renderer {
             .record(&ctx, cmd, &self.targets.gbuffer, &draw);
         timer.end(cmd);
 
-        if let Some(gi) = &mut self.gi {
+        let gi = self.gi.as_mut().filter(|_| self.indirect);
+        if let Some(gi) = gi {
             gi.record_update(cmd, timer, &draw);
         }
 
@@ -478,7 +496,7 @@ impl Renderer {
             self.radiance_last_use,
         );
         timer.end(cmd);
-        if let Some(gi) = &self.gi {
+        if let Some(gi) = self.gi.as_ref().filter(|_| self.indirect) {
             gi.record_gather(cmd, timer, data.set, extent);
         }
 

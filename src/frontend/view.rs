@@ -2,7 +2,7 @@
 //!
 //! Controls: drag with the left mouse button to look around, W/A/S/D to move, Q/E to
 //! go down/up, Shift to move faster; arrow keys move the first light in X/Z and
-//! PageUp/PageDown in Y; G cycles the GI method; Escape quits.
+//! PageUp/PageDown in Y; G turns the indirect light (`--gi dense`) off and on; Escape quits.
 
 use std::collections::HashSet;
 use std::ffi::CStr;
@@ -400,7 +400,17 @@ impl ApplicationHandler for App {
                             if code == KeyCode::Escape {
                                 event_loop.exit();
                             } else if code == KeyCode::KeyG && !event.repeat {
-                                log::info!("GI method: off (the only one so far)");
+                                if let Some(viewer) = self.viewer.as_mut() {
+                                    let on = viewer.renderer.toggle_indirect();
+                                    log::info!(
+                                        "indirect light {}",
+                                        if on {
+                                            "on"
+                                        } else {
+                                            "off (start with --gi dense to have it)"
+                                        }
+                                    );
+                                }
                             }
                             self.keys.insert(code);
                         }

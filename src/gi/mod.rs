@@ -388,6 +388,11 @@ impl DenseGi {
         Ok(())
     }
 
+    /// Forgets the accumulated bounces: the next frame computes them all again.
+    pub fn restart(&mut self) {
+        self.history = false;
+    }
+
     /// GPU memory of every voxel volume, by name.
     pub fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
         self.volumes.bytes()

@@ -2,7 +2,9 @@
 // Depth- and normal-aware upsampling of the gathered indirect light: each pixel blends
 // the four nearest reduced-resolution samples, bilinearly, down-weighting those whose
 // surface lies at another depth or faces another way, then adds albedo x gathered to
-// the direct light.
+// the direct light. Glossy pixels (Ks > 0) also trace one specular cone here, at full
+// resolution, as reflections are sharper than the diffuse light.
+#include "gi/cones.glsl"
 #include "gi/cone_trace/screen.glsl"
 
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
@@ -48,7 +50,16 @@ void main() {
         }
     }
     vec3 gathered = weight > 1e-6 ? sum / weight : vec3(0.0);
-    vec3 albedo = imageLoad(gbuffer_albedo, pixel).rgb;
+    vec4 albedo_specular = imageLoad(gbuffer_albedo, pixel);
+    vec3 indirect_light = albedo_specular.rgb * gathered;
+    float specular = albedo_specular.a;
+    if (specular > 0.0) {
+        // The cone's half-angle follows the roughness: tan(half) ~ roughness.
+        float roughness = clamp(imageLoad(gbuffer_normal, pixel).w, 0.02, 1.0);
+        vec3 v = normalize(frame.camera_position.xyz - p);
+        vec3 r = reflect(-v, n);
+        indirect_light += specular * trace_cone(p + n * (2.0 * gi.origin.w), r, roughness, 0.0).rgb;
+    }
     vec4 direct = imageLoad(screen_radiance, pixel);
-    imageStore(screen_radiance, pixel, vec4(direct.rgb + albedo * gathered, direct.a));
+    imageStore(screen_radiance, pixel, vec4(direct.rgb + indirect_light, direct.a));
 }
