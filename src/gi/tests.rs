@@ -25,8 +25,8 @@ fn shared_scene(path: &str) -> Option<std::path::PathBuf> {
     }
 }
 
-/// Renders one 64x64 frame of `scene` with `--gi dense --voxels n`.
-fn render(scene: Scene, n: u32) -> (Arc<Context>, Renderer) {
+/// Renders 64x64 frames of `scene` with `--gi dense --voxels n`, one at each time.
+fn render_at(scene: Scene, n: u32, times: &[f32]) -> (Arc<Context>, Renderer) {
     // Validation messages go to the log; show them when a test fails.
     let _ = env_logger::builder().is_test(true).try_init();
     let ctx = Context::new(&ContextOptions {
@@ -54,11 +54,26 @@ fn render(scene: Scene, n: u32) -> (Arc<Context>, Renderer) {
         before: ImageUse::UNDEFINED,
         after: ImageUse::COLOR_ATTACHMENT,
     };
-    let frame = renderer.begin_frame().unwrap();
-    renderer.record_frame(&frame, 0.0, &target).unwrap();
-    renderer.submit(frame, None, None).unwrap();
+    for (i, &time) in times.iter().enumerate() {
+        let target = OutputTarget {
+            before: if i == 0 {
+                ImageUse::UNDEFINED
+            } else {
+                ImageUse::discard_after(ImageUse::COLOR_ATTACHMENT)
+            },
+            ..target
+        };
+        let frame = renderer.begin_frame().unwrap();
+        renderer.record_frame(&frame, time, &target).unwrap();
+        renderer.submit(frame, None, None).unwrap();
+    }
     renderer.finish().unwrap();
     (ctx, renderer)
+}
+
+/// Renders one 64x64 frame of `scene` at time 0 with `--gi dense --voxels n`.
+fn render(scene: Scene, n: u32) -> (Arc<Context>, Renderer) {
+    render_at(scene, n, &[0.0])
 }
 
 fn world_triangles(scene: &Scene) -> Vec<[Vec3; 3]> {
@@ -200,4 +215,46 @@ fn filter_matches_cpu() {
     eprintln!("filter: worst relative difference {worst:.2e}");
     assert!(base.iter().any(|v| v[3] > 0.0), "empty radiance volume");
     assert_eq!(ctx.validation_messages(), 0);
+}
+
+/// A mesh moving across the Cornell box leaves no voxel behind: after frames at several
+/// times, the voxels equal a fresh voxelization at the last time.
+#[test]
+fn moving_mesh_leaves_no_voxels_behind() {
+    let Some(cornell) = shared_scene("scenes/cornell_box/CornellBox-Original.obj") else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("voxcone-moving-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("cube.obj"),
+        "v -0.15 0.3 -0.15\nv 0.15 0.3 -0.15\nv 0.15 0.6 -0.15\nv -0.15 0.6 -0.15\n\
+        v -0.15 0.3 0.15\nv 0.15 0.3 0.15\nv 0.15 0.6 0.15\nv -0.15 0.6 0.15\n\
+        f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n",
+    )
+    .unwrap();
+    let scene_file = dir.join("moving.toml");
+    std::fs::write(
+        &scene_file,
+        format!(
+            "[[mesh]]\npath = {:?}\n[[mesh]]\npath = \"cube.obj\"\n\
+             animate = {{ kind = \"oscillate\", axis = [1, 0, 0], amplitude = 0.6, period_s = 4 }}\n",
+            cornell.to_string_lossy()
+        ),
+    )
+    .unwrap();
+    let scene = Scene::load(&scene_file, &LoadOptions::default()).unwrap();
+    let (ctx, moved) = render_at(scene.clone(), 32, &[0.0, 0.5, 1.0]);
+    let moved_voxels = occupancy(&moved);
+    let (_, fresh) = render_at(scene.clone(), 32, &[1.0]);
+    let fresh_voxels = occupancy(&fresh);
+    let (_, start) = render_at(scene, 32, &[0.0]);
+    let start_voxels = occupancy(&start);
+    assert_ne!(start_voxels, fresh_voxels, "the cube did not move");
+    assert_eq!(
+        moved_voxels, fresh_voxels,
+        "voxels left behind or missing after the move"
+    );
+    assert_eq!(ctx.validation_messages(), 0);
+    std::fs::remove_dir_all(&dir).ok();
 }
