@@ -75,6 +75,9 @@ pub struct CommonArgs {
     /// Voxels per axis of the dense grid (a power of two).
     #[arg(long, default_value_t = 64)]
     pub voxels: u32,
+    /// Diffuse cones per gather: one along the normal, the rest in a ring at 60 degrees.
+    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub diffuse_cones: u32,
     /// Trace indirect light on one pixel of each NxN block and upsample (1: every pixel).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub indirect_scale: u32,
@@ -205,6 +208,7 @@ impl CommonArgs {
                 cones: ConeSettings {
                     bounces: self.bounces,
                     indirect_scale: self.indirect_scale,
+                    diffuse_cones: self.diffuse_cones,
                     accumulate_bounces: !self.no_accumulate,
                     ..ConeSettings::default()
                 },

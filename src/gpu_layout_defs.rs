@@ -80,8 +80,6 @@ gpu_layout! {
         BINDING_FILTER_NORMAL = 3;
         /// Workgroup edge of the 3D compute passes.
         VOXEL_GROUP_SIZE = 4;
-        /// Cones of the diffuse gather.
-        DIFFUSE_CONES = 6;
 
         /// `GpuLight.kind`: point light, intensity in W/sr.
         LIGHT_POINT = 0;
@@ -193,8 +191,8 @@ gpu_layout! {
         float max_distance,
         /// Indirect light is traced on one pixel of each `indirect_scale`² block.
         uint indirect_scale,
-        /// Unused.
-        float pad1,
+        /// Cones of the diffuse gather: one along the normal, the rest in a ring at 60 degrees.
+        uint diffuse_cones,
     }
 
     /// Push constants of every mesh draw.

@@ -62,15 +62,16 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod) {
 }
 
 
-// Cosine-weighted mean radiance over the hemisphere around n from six 60-degree cones:
-// one along n, five around it at 60 degrees.
+// Cosine-weighted mean radiance over the hemisphere around n from `gi.diffuse_cones`
+// cones: one along n, the others in a ring 60 degrees from it.
 vec3 gather_diffuse(vec3 origin, vec3 n, float min_lod) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);
     vec3 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod).rgb;
     float weight = 1.0;
-    for (int i = 0; i < DIFFUSE_CONES - 1; i++) {
-        float phi = 6.2831853 * float(i) / float(DIFFUSE_CONES - 1);
+    int ring = int(gi.diffuse_cones) - 1;
+    for (int i = 0; i < ring; i++) {
+        float phi = 6.2831853 * float(i) / float(ring);
         vec3 dir = normalize(0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b));
         sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod).rgb * 0.5;
         weight += 0.5;

@@ -62,6 +62,8 @@ impl Grid {
 pub struct ConeSettings {
     /// Full aperture of the diffuse cones, degrees.
     pub diffuse_aperture_deg: f32,
+    /// Number of diffuse cones: one along the normal, the rest in a ring at 60 degrees.
+    pub diffuse_cones: u32,
     /// Step length as a fraction of the cone diameter (beta).
     pub step_factor: f32,
     /// Light bounces between voxels: 1 is direct light on the voxels only.
@@ -77,6 +79,7 @@ impl Default for ConeSettings {
     fn default() -> Self {
         Self {
             diffuse_aperture_deg: 60.0,
+            diffuse_cones: 6,
             step_factor: 0.5,
             bounces: 4,
             indirect_scale: 2,
@@ -253,6 +256,7 @@ impl DenseGi {
             diffuse_tan_half: (cones.diffuse_aperture_deg.to_radians() * 0.5).tan(),
             max_distance: grid.voxel_size * resolution as f32 * 1.8,
             indirect_scale: cones.indirect_scale.max(1),
+            diffuse_cones: cones.diffuse_cones.clamp(1, 16),
             ..Default::default()
         };
         let uniforms = Buffer::with_data(
