@@ -257,7 +257,6 @@ impl DenseGi {
             max_distance: grid.voxel_size * resolution as f32 * 1.8,
             indirect_scale: cones.indirect_scale.max(1),
             diffuse_cones: cones.diffuse_cones.clamp(1, 16),
-            ..Default::default()
         };
         let uniforms = Buffer::with_data(
             ctx,
