@@ -75,18 +75,24 @@ pub struct CommonArgs {
     /// Voxels per axis of the dense grid (a power of two).
     #[arg(long, default_value_t = 64)]
     pub voxels: u32,
+    /// Full aperture of each diffuse cone, degrees (1 to 179).
+    #[arg(long, default_value_t = ConeSettings::default().diffuse_aperture_deg, value_parser = parse_aperture)]
+    pub diffuse_aperture: f32,
+    /// Cone step as a fraction of the cone's diameter (beta, 0.05 to 2).
+    #[arg(long, default_value_t = ConeSettings::default().step_factor, value_parser = parse_step_factor)]
+    pub step_factor: f32,
     /// Diffuse cones per gather: one along the normal, the rest in a ring at 60 degrees.
-    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=16))]
+    #[arg(long, default_value_t = ConeSettings::default().diffuse_cones, value_parser = clap::value_parser!(u32).range(1..=16))]
     pub diffuse_cones: u32,
     /// Trace indirect light on one pixel of each NxN block and upsample (1: every pixel).
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
+    #[arg(long, default_value_t = ConeSettings::default().indirect_scale, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub indirect_scale: u32,
     /// Recompute every bounce every frame, instead of adding one bounce per frame to the
     /// last frame's light (the first frame always computes them all).
     #[arg(long)]
     pub no_accumulate: bool,
     /// Light bounces between voxels (1: direct light on the voxels only).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
+    #[arg(long, default_value_t = ConeSettings::default().bounces, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub bounces: u32,
     /// Scene time in seconds (animation).
     #[arg(long, default_value_t = 0.0)]
@@ -159,6 +165,22 @@ pub struct CompareArgs {
     pub map: Option<PathBuf>,
 }
 
+fn parse_float_in(text: &str, min: f32, max: f32) -> Result<f32> {
+    match text.trim().parse::<f32>() {
+        Ok(v) if (min..=max).contains(&v) => Ok(v),
+        Ok(v) => bail!("{v} is out of range ({min} to {max})"),
+        Err(_) => bail!("expected a number, got {text:?}"),
+    }
+}
+
+fn parse_aperture(text: &str) -> Result<f32> {
+    parse_float_in(text, 1.0, 179.0)
+}
+
+fn parse_step_factor(text: &str) -> Result<f32> {
+    parse_float_in(text, 0.05, 2.0)
+}
+
 /// Parses `WIDTHxHEIGHT`.
 pub fn parse_size(text: &str) -> Result<(u32, u32)> {
     let Some((w, h)) = text.split_once(['x', 'X']) else {
@@ -209,8 +231,9 @@ impl CommonArgs {
                     bounces: self.bounces,
                     indirect_scale: self.indirect_scale,
                     diffuse_cones: self.diffuse_cones,
+                    diffuse_aperture_deg: self.diffuse_aperture,
+                    step_factor: self.step_factor,
                     accumulate_bounces: !self.no_accumulate,
-                    ..ConeSettings::default()
                 },
             }),
         }
