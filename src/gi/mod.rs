@@ -81,7 +81,7 @@ impl Default for ConeSettings {
             diffuse_aperture_deg: 60.0,
             diffuse_cones: 6,
             step_factor: 0.5,
-            bounces: 4,
+            bounces: 8,
             indirect_scale: 2,
             accumulate_bounces: true,
         }
