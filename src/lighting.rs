@@ -8,8 +8,8 @@ use ash::vk;
 use crate::gbuffer::GBuffer;
 use crate::gpu_layout as layout;
 use crate::vk::{
-    groups, image_barrier, Binding, Context, DescriptorSets, Image, ImageDesc, ImageUse, Pipeline,
-    SetWriter,
+    groups_2d, image_barrier, Binding, Context, DescriptorSets, Image, ImageDesc, ImageUse,
+    Pipeline, SetWriter,
 };
 
 /// Linear radiance; 32-bit floats so that an EXR written from it is exact.
@@ -111,18 +111,10 @@ impl LightingPass {
             ImageUse::discard_after(previous),
             ImageUse::COMPUTE_WRITE,
         );
-        self.pipeline.bind(
+        self.pipeline.dispatch(
             cmd,
             &[(layout::SET_FRAME, frame_set), (layout::SET_PASS, self.set)],
+            groups_2d(output.extent_2d(), layout::SCREEN_GROUP_SIZE),
         );
-        let extent = output.extent_2d();
-        unsafe {
-            ctx.device.cmd_dispatch(
-                cmd,
-                groups(extent.width, layout::SCREEN_GROUP_SIZE),
-                groups(extent.height, layout::SCREEN_GROUP_SIZE),
-                1,
-            )
-        };
     }
 }

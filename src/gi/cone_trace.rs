@@ -7,7 +7,7 @@ use anyhow::Result;
 use ash::vk;
 
 use crate::gpu_layout as layout;
-use crate::vk::{groups, Context, Pipeline};
+use crate::vk::{groups_2d, Context, Pipeline};
 
 pub struct ConeTracePass {
     pipeline: Pipeline,
@@ -37,46 +37,26 @@ impl ConeTracePass {
     /// Gathers at the reduced resolution `low`.
     pub fn record(
         &self,
-        ctx: &Context,
         cmd: vk::CommandBuffer,
         frame_set: vk::DescriptorSet,
         gi_set: vk::DescriptorSet,
         low: vk::Extent2D,
     ) {
-        dispatch_screen(ctx, cmd, &self.pipeline, frame_set, gi_set, low);
+        let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
+        self.pipeline
+            .dispatch(cmd, &sets, groups_2d(low, layout::SCREEN_GROUP_SIZE));
     }
 
     /// Adds the upsampled indirect light to every pixel of `extent`.
     pub fn record_upsample(
         &self,
-        ctx: &Context,
         cmd: vk::CommandBuffer,
         frame_set: vk::DescriptorSet,
         gi_set: vk::DescriptorSet,
         extent: vk::Extent2D,
     ) {
-        dispatch_screen(ctx, cmd, &self.upsample, frame_set, gi_set, extent);
+        let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
+        self.upsample
+            .dispatch(cmd, &sets, groups_2d(extent, layout::SCREEN_GROUP_SIZE));
     }
-}
-
-fn dispatch_screen(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    pipeline: &Pipeline,
-    frame_set: vk::DescriptorSet,
-    gi_set: vk::DescriptorSet,
-    extent: vk::Extent2D,
-) {
-    pipeline.bind(
-        cmd,
-        &[(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)],
-    );
-    unsafe {
-        ctx.device.cmd_dispatch(
-            cmd,
-            groups(extent.width, layout::SCREEN_GROUP_SIZE),
-            groups(extent.height, layout::SCREEN_GROUP_SIZE),
-            1,
-        )
-    };
 }

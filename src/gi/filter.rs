@@ -8,7 +8,7 @@ use ash::vk;
 
 use super::{compute_to_compute, Volumes};
 use crate::gpu_layout as layout;
-use crate::vk::{groups, Binding, Context, DescriptorSets, OwnedView, Pipeline, SetWriter};
+use crate::vk::{groups_3d, Binding, Context, DescriptorSets, OwnedView, Pipeline, SetWriter};
 
 pub struct FilterPass {
     pipeline: Pipeline,
@@ -73,12 +73,14 @@ impl FilterPass {
             if level > 0 {
                 compute_to_compute(ctx, cmd);
             }
-            self.pipeline.bind(cmd, &[(layout::SET_PASS, set)]);
             self.pipeline
                 .push(cmd, vk::ShaderStageFlags::COMPUTE, &(level as u32));
             let size = (n >> (level + 1)).max(1);
-            let g = groups(size, layout::VOXEL_GROUP_SIZE);
-            unsafe { ctx.device.cmd_dispatch(cmd, g, g, g) };
+            self.pipeline.dispatch(
+                cmd,
+                &[(layout::SET_PASS, set)],
+                groups_3d(size, layout::VOXEL_GROUP_SIZE),
+            );
         }
     }
 }

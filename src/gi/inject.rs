@@ -6,7 +6,7 @@ use anyhow::Result;
 use ash::vk;
 
 use crate::gpu_layout as layout;
-use crate::vk::{groups, Context, Pipeline};
+use crate::vk::{groups_3d, Context, Pipeline};
 
 pub struct InjectPass {
     pipeline: Pipeline,
@@ -35,40 +35,26 @@ impl InjectPass {
 
     pub fn record(
         &self,
-        ctx: &Context,
         cmd: vk::CommandBuffer,
         frame_set: vk::DescriptorSet,
         gi_set: vk::DescriptorSet,
         n: u32,
     ) {
-        dispatch_voxels(ctx, cmd, &self.pipeline, frame_set, gi_set, n);
+        let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
+        self.pipeline
+            .dispatch(cmd, &sets, groups_3d(n, layout::VOXEL_GROUP_SIZE));
     }
 
     /// One more bounce: direct + albedo x gathered filtered radiance, into the radiance.
     pub fn record_bounce(
         &self,
-        ctx: &Context,
         cmd: vk::CommandBuffer,
         frame_set: vk::DescriptorSet,
         gi_set: vk::DescriptorSet,
         n: u32,
     ) {
-        dispatch_voxels(ctx, cmd, &self.bounce, frame_set, gi_set, n);
+        let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
+        self.bounce
+            .dispatch(cmd, &sets, groups_3d(n, layout::VOXEL_GROUP_SIZE));
     }
-}
-
-fn dispatch_voxels(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    pipeline: &Pipeline,
-    frame_set: vk::DescriptorSet,
-    gi_set: vk::DescriptorSet,
-    n: u32,
-) {
-    pipeline.bind(
-        cmd,
-        &[(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)],
-    );
-    let g = groups(n, layout::VOXEL_GROUP_SIZE);
-    unsafe { ctx.device.cmd_dispatch(cmd, g, g, g) };
 }

@@ -463,7 +463,7 @@ impl DenseGi {
         // Last frame's cone tracing sampled the radiance volumes that are rewritten now.
         compute_to_compute(ctx, cmd);
         self.inject
-            .record(ctx, cmd, draw.frame_set, self.set, self.grid.resolution);
+            .record(cmd, draw.frame_set, self.set, self.grid.resolution);
         timer.end(cmd);
 
         let bounces = if self.history { 1 } else { self.bounces - 1 };
@@ -478,7 +478,7 @@ impl DenseGi {
             timer.begin(cmd, "bounce");
             compute_to_compute(ctx, cmd);
             self.inject
-                .record_bounce(ctx, cmd, draw.frame_set, self.set, self.grid.resolution);
+                .record_bounce(cmd, draw.frame_set, self.set, self.grid.resolution);
             compute_to_compute(ctx, cmd);
             self.filter.record(ctx, cmd, self.grid.resolution);
             timer.end(cmd);
@@ -500,14 +500,13 @@ impl DenseGi {
             width: extent.width.div_ceil(scale),
             height: extent.height.div_ceil(scale),
         };
-        self.cone_trace
-            .record(&self.ctx, cmd, frame_set, self.set, low);
+        self.cone_trace.record(cmd, frame_set, self.set, low);
         timer.end(cmd);
 
         timer.begin(cmd, "upsample");
         compute_to_compute(&self.ctx, cmd);
         self.cone_trace
-            .record_upsample(&self.ctx, cmd, frame_set, self.set, extent);
+            .record_upsample(cmd, frame_set, self.set, extent);
         timer.end(cmd);
     }
 

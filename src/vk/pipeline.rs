@@ -100,6 +100,21 @@ impl Pipeline {
         }
     }
 
+    /// Binds this compute pipeline and `sets`, then dispatches `groups` workgroups.
+    pub fn dispatch(
+        &self,
+        cmd: vk::CommandBuffer,
+        sets: &[(u32, vk::DescriptorSet)],
+        groups: [u32; 3],
+    ) {
+        self.bind(cmd, sets);
+        unsafe {
+            self.ctx
+                .device
+                .cmd_dispatch(cmd, groups[0], groups[1], groups[2])
+        };
+    }
+
     /// Binds one more descriptor set to the bound pipeline.
     pub fn bind_set(&self, cmd: vk::CommandBuffer, index: u32, set: vk::DescriptorSet) {
         unsafe {
@@ -313,4 +328,15 @@ pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D)
 /// Workgroup count covering `size` items with groups of `group`.
 pub fn groups(size: u32, group: u32) -> u32 {
     size.div_ceil(group).max(1)
+}
+
+/// Workgroups covering an image of `extent` with square groups of edge `group`.
+pub fn groups_2d(extent: vk::Extent2D, group: u32) -> [u32; 3] {
+    [groups(extent.width, group), groups(extent.height, group), 1]
+}
+
+/// Workgroups covering an `n`³ volume with cubic groups of edge `group`.
+pub fn groups_3d(n: u32, group: u32) -> [u32; 3] {
+    let g = groups(n, group);
+    [g, g, g]
 }
