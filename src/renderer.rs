@@ -18,8 +18,8 @@ use crate::scene::{Camera, LightKind, Scene};
 use crate::scene_gpu::{GpuScene, SceneDraw};
 use crate::shadow::{self, ShadowPass};
 use crate::vk::{
-    image_barrier, memory_barrier, Binding, Buffer, Context, DescriptorSets, Frame, FrameRing,
-    GpuTimer, Image, ImageUse, Sampler, SetWriter,
+    image_barrier, memory_barrier, sampler_info, Binding, Buffer, Context, DescriptorSets, Frame,
+    FrameRing, GpuTimer, Image, ImageUse, Sampler, SetWriter,
 };
 
 /// How the final image is mapped to the display.
@@ -178,21 +178,13 @@ impl Renderer {
         let nearest_sampler = Sampler::new(
             ctx,
             "nearest",
-            &vk::SamplerCreateInfo::default()
-                .mag_filter(vk::Filter::NEAREST)
-                .min_filter(vk::Filter::NEAREST)
-                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE),
+            &sampler_info(vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE),
         )?;
         // Outside a shadow map's coverage reads as lit (border depth 1).
         let shadow_sampler = Sampler::new(
             ctx,
             "shadow compare",
-            &vk::SamplerCreateInfo::default()
-                .mag_filter(vk::Filter::LINEAR)
-                .min_filter(vk::Filter::LINEAR)
-                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_BORDER)
-                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_BORDER)
+            &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::CLAMP_TO_BORDER)
                 .border_color(vk::BorderColor::FLOAT_OPAQUE_WHITE)
                 .compare_enable(true)
                 .compare_op(vk::CompareOp::LESS_OR_EQUAL),

@@ -9,8 +9,8 @@ use ash::vk;
 use crate::gpu_layout::{self as layout, DrawPush, GpuMaterial};
 use crate::scene::{Scene, TextureKind, Vertex};
 use crate::vk::{
-    image_barrier, upload_buffer, Binding, Buffer, Context, DescriptorSets, Image, ImageDesc,
-    ImageUse, OneShot, Pipeline, Sampler, SetWriter,
+    image_barrier, sampler_info, upload_buffer, Binding, Buffer, Context, DescriptorSets, Image,
+    ImageDesc, ImageUse, OneShot, Pipeline, Sampler, SetWriter,
 };
 
 /// What mesh draws need: the scene at a time and the descriptor sets to bind.
@@ -212,16 +212,9 @@ impl GpuScene {
         let sampler = Sampler::new(
             ctx,
             "material sampler",
-            &vk::SamplerCreateInfo::default()
-                .mag_filter(vk::Filter::LINEAR)
-                .min_filter(vk::Filter::LINEAR)
-                .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
-                .address_mode_u(vk::SamplerAddressMode::REPEAT)
-                .address_mode_v(vk::SamplerAddressMode::REPEAT)
-                .address_mode_w(vk::SamplerAddressMode::REPEAT)
+            &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::REPEAT)
                 .anisotropy_enable(ctx.features.sampler_anisotropy)
-                .max_anisotropy(max_anisotropy)
-                .max_lod(vk::LOD_CLAMP_NONE),
+                .max_anisotropy(max_anisotropy),
         )?;
         let sets = DescriptorSets::new(
             ctx,

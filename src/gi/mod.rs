@@ -24,8 +24,8 @@ use crate::gpu_layout::{self as layout, GiUniforms};
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
-    image_barrier, memory_barrier, Binding, Buffer, Context, DescriptorSets, GpuTimer, Image,
-    ImageDesc, ImageUse, OneShot, Sampler, SetWriter,
+    image_barrier, memory_barrier, sampler_info, Binding, Buffer, Context, DescriptorSets,
+    GpuTimer, Image, ImageDesc, ImageUse, OneShot, Sampler, SetWriter,
 };
 
 /// The cube the voxels tile: voxel (i, j, k) covers origin + [i, i+1) x [j, j+1) x [k, k+1)
@@ -269,16 +269,9 @@ impl DenseGi {
         let linear = Sampler::new(
             ctx,
             "voxel linear",
-            &vk::SamplerCreateInfo::default()
-                .mag_filter(vk::Filter::LINEAR)
-                .min_filter(vk::Filter::LINEAR)
-                .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
-                // Not a transparent border: at coarse levels the grid is a few texels
-                // across, and filtering towards a border would thin every wall there.
-                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                .max_lod(vk::LOD_CLAMP_NONE),
+            // Not a transparent border: at coarse levels the grid is a few texels across,
+            // and filtering towards a border would thin every wall there.
+            &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::CLAMP_TO_EDGE),
         )?;
         SetWriter::new(ctx, set)
             .buffer(

@@ -308,6 +308,27 @@ impl Drop for OwnedView {
     }
 }
 
+/// Sampler settings with one filter for magnification, minification and mips, and one
+/// address mode on every axis; callers add what else they need.
+pub fn sampler_info(
+    filter: vk::Filter,
+    address: vk::SamplerAddressMode,
+) -> vk::SamplerCreateInfo<'static> {
+    let mipmap = if filter == vk::Filter::LINEAR {
+        vk::SamplerMipmapMode::LINEAR
+    } else {
+        vk::SamplerMipmapMode::NEAREST
+    };
+    vk::SamplerCreateInfo::default()
+        .mag_filter(filter)
+        .min_filter(filter)
+        .mipmap_mode(mipmap)
+        .address_mode_u(address)
+        .address_mode_v(address)
+        .address_mode_w(address)
+        .max_lod(vk::LOD_CLAMP_NONE)
+}
+
 /// A sampler, destroyed when dropped.
 pub struct Sampler {
     pub raw: vk::Sampler,

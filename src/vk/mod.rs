@@ -13,7 +13,9 @@ mod timestamps;
 pub use commands::{image_barrier, memory_barrier, ImageUse, OneShot};
 pub use context::{Context, ContextOptions, Features};
 pub use descriptors::{Binding, DescriptorSets, SetWriter};
-pub use memory::{is_depth_format, upload_buffer, Buffer, Image, ImageDesc, OwnedView, Sampler};
+pub use memory::{
+    is_depth_format, sampler_info, upload_buffer, Buffer, Image, ImageDesc, OwnedView, Sampler,
+};
 pub use pipeline::{groups_2d, groups_3d, set_viewport, GraphicsDesc, Pipeline};
 pub use swapchain::{Acquired, Swapchain};
 pub use sync::{Frame, FrameRing};
