@@ -18,8 +18,8 @@ use crate::scene::{Camera, LightKind, Scene};
 use crate::scene_gpu::{GpuScene, SceneDraw};
 use crate::shadow::{self, ShadowPass};
 use crate::vk::{
-    image_barrier, memory_barrier, sampler_info, Binding, Buffer, Context, DescriptorSets, Frame,
-    FrameRing, GpuTimer, Image, ImageUse, Sampler, SetWriter,
+    copies_to_host_barrier, image_barrier, sampler_info, Binding, Buffer, Context, DescriptorSets,
+    Frame, FrameRing, GpuTimer, Image, ImageUse, Sampler, SetWriter,
 };
 
 /// How the final image is mapped to the display.
@@ -606,13 +606,5 @@ pub fn copy_image_to_buffer(
             &[region],
         )
     };
-    memory_barrier(
-        ctx,
-        cmd,
-        (
-            vk::PipelineStageFlags2::COPY,
-            vk::AccessFlags2::TRANSFER_WRITE,
-        ),
-        (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-    );
+    copies_to_host_barrier(ctx, cmd);
 }

@@ -24,8 +24,8 @@ use crate::gpu_layout::{self as layout, GiUniforms};
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
-    image_barrier, memory_barrier, sampler_info, Binding, Buffer, Context, DescriptorSets,
-    GpuTimer, Image, ImageDesc, ImageUse, OneShot, Sampler, SetWriter,
+    copies_to_host_barrier, image_barrier, memory_barrier, sampler_info, Binding, Buffer, Context,
+    DescriptorSets, GpuTimer, Image, ImageDesc, ImageUse, OneShot, Sampler, SetWriter,
 };
 
 /// The cube the voxels tile: voxel (i, j, k) covers origin + [i, i+1) x [j, j+1) x [k, k+1)
@@ -585,15 +585,7 @@ impl DenseGi {
                 ImageUse::TRANSFER_SRC,
                 any_shader,
             );
-            memory_barrier(
-                ctx,
-                cmd,
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                ),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
+            copies_to_host_barrier(ctx, cmd);
             Ok(())
         })?;
         let bytes = buffer.mapped();

@@ -134,6 +134,20 @@ pub fn memory_barrier(
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
 }
 
+/// Makes the copies recorded before it visible to host reads of their buffers (after the
+/// submit is waited for).
+pub fn copies_to_host_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
+    memory_barrier(
+        ctx,
+        cmd,
+        (
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_WRITE,
+        ),
+        (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+    );
+}
+
 /// A command pool for work submitted once and waited for (uploads, read-backs).
 pub struct OneShot {
     pool: vk::CommandPool,
