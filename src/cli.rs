@@ -5,9 +5,9 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use crate::gi::ConeSettings;
-use crate::renderer::{GiSettings, RenderSettings, Tonemap};
-use crate::scene::LoadOptions;
+use crate::gi::{check_voxels, ConeSettings, DEFAULT_VOXELS};
+use crate::renderer::{DebugView, GiSettings, RenderSettings, Terms, Tonemap};
+use crate::scene::{GiOverrides, LoadOptions};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -63,6 +63,10 @@ pub struct CommonArgs {
     /// Ignore normal and bump maps, as the path-traced references do.
     #[arg(long)]
     pub no_normal_maps: bool,
+    /// Ignore MTL Ni: surfaces with d < 1 pass light straight through, as the
+    /// path-traced references' masks do.
+    #[arg(long)]
+    pub no_refraction: bool,
     /// Exposure in stops before the tonemap (PNG and window only; EXR stays raw radiance).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
@@ -72,28 +76,73 @@ pub struct CommonArgs {
     /// Shadow map resolution per light view.
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub shadow_res: u32,
-    /// Voxels per axis of the dense grid (a power of two).
-    #[arg(long, default_value_t = 64)]
-    pub voxels: u32,
-    /// Full aperture of each diffuse cone, degrees (1 to 179).
-    #[arg(long, default_value_t = ConeSettings::default().diffuse_aperture_deg, value_parser = parse_aperture)]
-    pub diffuse_aperture: f32,
-    /// Cone step as a fraction of the cone's diameter (beta, 0.05 to 2).
-    #[arg(long, default_value_t = ConeSettings::default().step_factor, value_parser = parse_step_factor)]
-    pub step_factor: f32,
-    /// Diffuse cones per gather: one along the normal, the rest in a ring at 60 degrees.
-    #[arg(long, default_value_t = ConeSettings::default().diffuse_cones, value_parser = clap::value_parser!(u32).range(1..=16))]
-    pub diffuse_cones: u32,
-    /// Trace indirect light on one pixel of each NxN block and upsample (1: every pixel).
-    #[arg(long, default_value_t = ConeSettings::default().indirect_scale, value_parser = clap::value_parser!(u32).range(1..=8))]
-    pub indirect_scale: u32,
+    /// Voxels per axis of the dense grid, a power of two from 4 to 1024 [default: 64,
+    /// or the scene file's [gi] voxels].
+    #[arg(long)]
+    pub voxels: Option<u32>,
+    /// Full aperture of each diffuse cone, degrees, 1 to 179 [default: 60].
+    #[arg(long)]
+    pub diffuse_aperture: Option<f32>,
+    /// Cone step as a fraction of the cone's diameter (beta), 0.05 to 2 [default: 0.5].
+    #[arg(long)]
+    pub step_factor: Option<f32>,
+    /// Diffuse cones per gather, 1 to 16: one along the normal, the rest in a ring at 60
+    /// degrees [default: 6].
+    #[arg(long)]
+    pub diffuse_cones: Option<u32>,
+    /// Trace indirect light on one pixel of each NxN block and upsample, 1 to 8
+    /// [default: 2].
+    #[arg(long)]
+    pub indirect_scale: Option<u32>,
     /// Recompute every bounce every frame, instead of adding one bounce per frame to the
     /// last frame's light (the first frame always computes them all).
     #[arg(long)]
     pub no_accumulate: bool,
-    /// Light bounces between voxels (1: direct light on the voxels only).
-    #[arg(long, default_value_t = ConeSettings::default().bounces, value_parser = clap::value_parser!(u32).range(1..=8))]
-    pub bounces: u32,
+    /// Light bounces between voxels, 1 to 8 (1: direct light on the voxels only)
+    /// [default: 8].
+    #[arg(long)]
+    pub bounces: Option<u32>,
+    /// Shadow the direct light with soft-shadow cones through the voxels instead of with
+    /// shadow maps (needs --gi dense).
+    #[arg(long)]
+    pub shadow_cones: bool,
+    /// Full aperture of the soft-shadow cones, degrees, 0.1 to 90: the apparent size of
+    /// the lights [default: 4].
+    #[arg(long)]
+    pub shadow_aperture: Option<f32>,
+    /// Ambient occlusion: occluders this many voxels away occlude half as much, 0.1 to
+    /// 1024 [default: 4].
+    #[arg(long)]
+    pub ao_distance: Option<f32>,
+    /// Re-voxelize and re-shade the static geometry every frame too (for benchmarks);
+    /// by default static geometry is voxelized once and only moving meshes every frame.
+    #[arg(long)]
+    pub full_update: bool,
+    /// Leave out the direct light.
+    #[arg(long)]
+    pub no_direct: bool,
+    /// Leave out emitted light.
+    #[arg(long)]
+    pub no_emission: bool,
+    /// Leave out the indirect diffuse light.
+    #[arg(long)]
+    pub no_indirect: bool,
+    /// Leave out the cone-traced specular reflections.
+    #[arg(long)]
+    pub no_indirect_specular: bool,
+    /// Draw transmissive surfaces (d < 1) opaque, without the refraction cone.
+    #[arg(long)]
+    pub no_transmission: bool,
+    /// Multiply the indirect light by ambient occlusion (contact shadows; the cone-traced
+    /// light is already occluded, so this darkens twice and is off by default).
+    #[arg(long)]
+    pub ao: bool,
+    /// Show a debug view instead of the image (needs --gi dense).
+    #[arg(long, value_enum, default_value_t = DebugView::None)]
+    pub debug_view: DebugView,
+    /// Mip level of the voxel debug views (0: the voxels themselves).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=10))]
+    pub debug_level: u32,
     /// Scene time in seconds (animation).
     #[arg(long, default_value_t = 0.0)]
     pub time: f32,
@@ -165,22 +214,6 @@ pub struct CompareArgs {
     pub map: Option<PathBuf>,
 }
 
-fn parse_float_in(text: &str, min: f32, max: f32) -> Result<f32> {
-    match text.trim().parse::<f32>() {
-        Ok(v) if (min..=max).contains(&v) => Ok(v),
-        Ok(v) => bail!("{v} is out of range ({min} to {max})"),
-        Err(_) => bail!("expected a number, got {text:?}"),
-    }
-}
-
-fn parse_aperture(text: &str) -> Result<f32> {
-    parse_float_in(text, 1.0, 179.0)
-}
-
-fn parse_step_factor(text: &str) -> Result<f32> {
-    parse_float_in(text, 0.05, 2.0)
-}
-
 /// Parses `WIDTHxHEIGHT`.
 pub fn parse_size(text: &str) -> Result<(u32, u32)> {
     let Some((w, h)) = text.split_once(['x', 'X']) else {
@@ -203,7 +236,8 @@ impl CommonArgs {
     }
 
     /// Reference scenes (`*.scene.json`) declare two-sided Lambertian materials without
-    /// normal maps, so loading one implies `--diffuse-only --no-normal-maps`.
+    /// normal maps, d as a straight-through mask, so loading one implies
+    /// `--diffuse-only --no-normal-maps --no-refraction`.
     fn is_reference(&self) -> bool {
         self.scene_path().to_string_lossy().ends_with(".scene.json")
     }
@@ -213,30 +247,87 @@ impl CommonArgs {
         LoadOptions {
             diffuse_only: self.diffuse_only || reference,
             no_normal_maps: self.no_normal_maps || reference,
+            no_refraction: self.no_refraction || reference,
         }
     }
 
-    pub fn render_settings(&self) -> RenderSettings {
+    /// The settings of a frame: the command line over the scene file's `[gi]` over the
+    /// defaults.
+    pub fn render_settings(&self, scene: &GiOverrides) -> Result<RenderSettings> {
         let options = self.load_options();
-        RenderSettings {
+        let d = ConeSettings::default();
+        let cones = ConeSettings {
+            bounces: self.bounces.or(scene.bounces).unwrap_or(d.bounces),
+            indirect_scale: self
+                .indirect_scale
+                .or(scene.indirect_scale)
+                .unwrap_or(d.indirect_scale),
+            diffuse_cones: self
+                .diffuse_cones
+                .or(scene.diffuse_cones)
+                .unwrap_or(d.diffuse_cones),
+            diffuse_aperture_deg: self
+                .diffuse_aperture
+                .or(scene.diffuse_aperture_deg)
+                .unwrap_or(d.diffuse_aperture_deg),
+            step_factor: self
+                .step_factor
+                .or(scene.step_factor)
+                .unwrap_or(d.step_factor),
+            accumulate_bounces: !self.no_accumulate,
+            shadow_aperture_deg: self
+                .shadow_aperture
+                .or(scene.shadow_aperture_deg)
+                .unwrap_or(d.shadow_aperture_deg),
+            ao_distance_voxels: self
+                .ao_distance
+                .or(scene.ao_distance_voxels)
+                .unwrap_or(d.ao_distance_voxels),
+        };
+        let voxels = self.voxels.or(scene.voxels).unwrap_or(DEFAULT_VOXELS);
+        let shadow_cones = self.shadow_cones || scene.shadow_cones.unwrap_or(false);
+        let gi = match self.gi {
+            GiMode::Dense => {
+                cones.check()?;
+                check_voxels(voxels)?;
+                Some(GiSettings {
+                    voxels,
+                    cones,
+                    shadow_cones,
+                    full_update: self.full_update,
+                })
+            }
+            GiMode::Off => {
+                let needs_gi = [
+                    (self.shadow_cones, "--shadow-cones"),
+                    (self.full_update, "--full-update"),
+                    (self.debug_view != DebugView::None, "--debug-view"),
+                ];
+                if let Some((_, option)) = needs_gi.iter().find(|(set, _)| *set) {
+                    bail!("{option} works on the voxels: it needs --gi dense");
+                }
+                None
+            }
+        };
+        Ok(RenderSettings {
             specular: !options.diffuse_only,
             normal_maps: !options.no_normal_maps,
             exposure_ev: self.exposure,
             tonemap: self.tonemap,
             shadow_resolution: self.shadow_res,
             cache_shadows: true,
-            gi: (self.gi == GiMode::Dense).then_some(GiSettings {
-                voxels: self.voxels,
-                cones: ConeSettings {
-                    bounces: self.bounces,
-                    indirect_scale: self.indirect_scale,
-                    diffuse_cones: self.diffuse_cones,
-                    diffuse_aperture_deg: self.diffuse_aperture,
-                    step_factor: self.step_factor,
-                    accumulate_bounces: !self.no_accumulate,
-                },
-            }),
-        }
+            terms: Terms {
+                direct: !self.no_direct,
+                emission: !self.no_emission,
+                indirect_diffuse: !self.no_indirect,
+                indirect_specular: !self.no_indirect_specular,
+                transmission: !self.no_transmission,
+                ambient_occlusion: self.ao,
+            },
+            debug_view: self.debug_view,
+            debug_level: self.debug_level,
+            gi,
+        })
     }
 
     pub fn validation(&self) -> bool {

@@ -13,6 +13,13 @@ use crate::vk::{
 
 pub const COLOR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+pub const TRANSMISSION_FORMAT: vk::Format = vk::Format::R16G16_SFLOAT;
+const COLOR_FORMATS: [vk::Format; 4] = [
+    COLOR_FORMAT,
+    COLOR_FORMAT,
+    COLOR_FORMAT,
+    TRANSMISSION_FORMAT,
+];
 
 /// The G-buffer images of one resolution.
 pub struct GBuffer {
@@ -22,23 +29,26 @@ pub struct GBuffer {
     pub normal: Image,
     /// rgb emitted radiance.
     pub emission: Image,
+    /// r transmittance (1 - MTL d), g index of refraction (MTL Ni).
+    pub transmission: Image,
     pub depth: Image,
 }
 
 impl GBuffer {
     pub fn new(ctx: &Arc<Context>, extent: vk::Extent2D) -> Result<Self> {
         let color_usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE;
-        let color = |name| {
+        let color = |name, format| {
             Image::new(
                 ctx,
                 name,
-                ImageDesc::d2(COLOR_FORMAT, extent.width, extent.height, color_usage),
+                ImageDesc::d2(format, extent.width, extent.height, color_usage),
             )
         };
         Ok(Self {
-            albedo: color("gbuffer albedo")?,
-            normal: color("gbuffer normal")?,
-            emission: color("gbuffer emission")?,
+            albedo: color("gbuffer albedo", COLOR_FORMAT)?,
+            normal: color("gbuffer normal", COLOR_FORMAT)?,
+            emission: color("gbuffer emission", COLOR_FORMAT)?,
+            transmission: color("gbuffer transmission", TRANSMISSION_FORMAT)?,
             depth: Image::new(
                 ctx,
                 "gbuffer depth",
@@ -56,8 +66,13 @@ impl GBuffer {
         self.depth.extent_2d()
     }
 
-    fn colors(&self) -> [&Image; 3] {
-        [&self.albedo, &self.normal, &self.emission]
+    fn colors(&self) -> [&Image; 4] {
+        [
+            &self.albedo,
+            &self.normal,
+            &self.emission,
+            &self.transmission,
+        ]
     }
 
     /// How later passes read the colour targets and the depth.
@@ -82,7 +97,7 @@ impl GBufferPass {
                 attributes: &VERTEX_ATTRIBUTES,
                 set_layouts,
                 push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
-                color_formats: &[COLOR_FORMAT; 3],
+                color_formats: &COLOR_FORMATS,
                 depth_format: Some(DEPTH_FORMAT),
                 // Surfaces are two-sided (the references' convention).
                 cull: vk::CullModeFlags::NONE,

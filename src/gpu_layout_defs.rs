@@ -68,8 +68,10 @@ gpu_layout! {
         BINDING_GI_GBUFFER_DEPTH = 10;
         /// GI passes (set 2): voxel direct radiance (before bounces), `rgba16f` storage.
         BINDING_GI_DIRECT = 11;
-        /// GI passes (set 2): gathered indirect radiance at reduced resolution, `rgba16f` storage.
+        /// GI passes (set 2): gathered indirect radiance (rgb) and ambient occlusion (a) at reduced resolution, `rgba16f` storage.
         BINDING_GI_INDIRECT = 12;
+        /// GI passes (set 2): G-buffer transmittance (r) and index of refraction (g), `rg16f` storage.
+        BINDING_GI_GBUFFER_TRANSMISSION = 13;
         /// filter pass (set 2): the base radiance, read by the first level, `rgba16f` storage.
         BINDING_FILTER_BASE = 0;
         /// filter pass (set 2): the directional level read (levels after the first), `rgba16f` storage.
@@ -94,6 +96,33 @@ gpu_layout! {
         FLAG_NORMAL_MAPS = 2;
         /// `FrameUniforms.flags`: filmic (ACES) tonemap instead of a plain clamp.
         FLAG_TONEMAP_ACES = 4;
+        /// `FrameUniforms.flags`: add the direct light of the scene's lights.
+        FLAG_DIRECT = 8;
+        /// `FrameUniforms.flags`: add emitted radiance (and the sky seen directly).
+        FLAG_EMISSION = 16;
+        /// `FrameUniforms.flags`: add albedo x cone-traced indirect diffuse light.
+        FLAG_INDIRECT_DIFFUSE = 32;
+        /// `FrameUniforms.flags`: add the cone-traced specular reflection.
+        FLAG_INDIRECT_SPECULAR = 64;
+        /// `FrameUniforms.flags`: add light refracted through transmissive surfaces.
+        FLAG_TRANSMISSION = 128;
+        /// `FrameUniforms.flags`: multiply the indirect light by ambient occlusion.
+        FLAG_AO = 256;
+        /// `FrameUniforms.flags`: soft-shadow cones through the voxels instead of shadow maps.
+        FLAG_SHADOW_CONES = 512;
+
+        /// `FrameUniforms.debug_view`: the composited image.
+        DEBUG_NONE = 0;
+        /// `FrameUniforms.debug_view`: indirect light only (diffuse + specular + transmission).
+        DEBUG_INDIRECT = 1;
+        /// `FrameUniforms.debug_view`: ambient occlusion only.
+        DEBUG_AO = 2;
+        /// `FrameUniforms.debug_view`: voxel albedo at mip `debug_level`.
+        DEBUG_VOXEL_ALBEDO = 3;
+        /// `FrameUniforms.debug_view`: voxel normal (xyz * 0.5 + 0.5) at mip `debug_level`.
+        DEBUG_VOXEL_NORMAL = 4;
+        /// `FrameUniforms.debug_view`: voxel radiance at mip `debug_level`.
+        DEBUG_VOXEL_RADIANCE = 5;
 
     }
 
@@ -119,6 +148,14 @@ gpu_layout! {
         uint light_count,
         /// `FLAG_*` bits.
         uint flags,
+        /// `DEBUG_*`: what the image shows.
+        uint debug_view,
+        /// Mip level of the voxel debug views (0 = the voxels themselves).
+        uint debug_level,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
     }
 
     /// One light.
@@ -193,6 +230,14 @@ gpu_layout! {
         uint indirect_scale,
         /// Cones of the diffuse gather: one along the normal, the rest in a ring at 60 degrees.
         uint diffuse_cones,
+        /// tan of half the aperture of the soft-shadow cones.
+        float shadow_tan_half,
+        /// Occluders this far away (world units) occlude half as much as adjacent ones.
+        float ao_distance,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
     }
 
     /// Push constants of every mesh draw.

@@ -34,12 +34,30 @@ impl SceneDraw<'_> {
         shadow_view: u32,
         pass_set: Option<vk::DescriptorSet>,
     ) {
+        self.draw_meshes_where(ctx, cmd, pipeline, shadow_view, pass_set, |_| true);
+    }
+
+    /// [`Self::draw_meshes`] for the meshes `keep` accepts.
+    pub fn draw_meshes_where(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        pipeline: &Pipeline,
+        shadow_view: u32,
+        pass_set: Option<vk::DescriptorSet>,
+        keep: impl Fn(&crate::scene::Mesh) -> bool,
+    ) {
         pipeline.bind(cmd, &[(layout::SET_FRAME, self.frame_set)]);
         if let Some(set) = pass_set {
             pipeline.bind_set(cmd, layout::SET_PASS, set);
         }
         self.gpu.bind_geometry(ctx, cmd);
-        for draw in &self.gpu.draws {
+        for draw in self
+            .gpu
+            .draws
+            .iter()
+            .filter(|d| keep(&self.scene.meshes[d.mesh]))
+        {
             let push = DrawPush {
                 model: self
                     .scene

@@ -49,26 +49,48 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset) {
     return sum / 25.0;
 }
 
-// Irradiance at p (normal n) from one light, shadowed, and the unit vector towards it.
-vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, float extra_offset, out vec3 to_light) {
+// Irradiance at p (normal n) from one light, unshadowed, the unit vector towards it and
+// the distance to it (infinite for a directional light).
+vec3 light_incident(GpuLight light, vec3 p, vec3 n, out vec3 to_light, out float dist) {
     vec3 e;
     if (light.kind == LIGHT_DIRECTIONAL) {
         to_light = -light.direction.xyz;
+        dist = 1e30;
         e = light.intensity.rgb;
     } else {
         vec3 d = light.position.xyz - p;
         float dist2 = max(dot(d, d), 1e-8);
-        to_light = d * inversesqrt(dist2);
+        dist = sqrt(dist2);
+        to_light = d / dist;
         e = light.intensity.rgb / dist2;
         if (light.kind == LIGHT_SPOT) {
             float cos_axis = dot(-to_light, light.direction.xyz);
             e *= smoothstep(light.direction.w, light.cos_inner, cos_axis);
         }
     }
-    float cos_theta = dot(n, to_light);
-    if (cos_theta <= 0.0) {
-        return vec3(0.0);
+    return e * max(dot(n, to_light), 0.0);
+}
+
+// Irradiance at p (normal n) from one light, shadowed, and the unit vector towards it.
+vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, float extra_offset, out vec3 to_light) {
+    float dist;
+    vec3 e = light_incident(light, p, n, to_light, dist);
+    if (all(equal(e, vec3(0.0)))) {
+        return e;
     }
-    return e * cos_theta * shadow_visibility(light, p, n, extra_offset);
+    return e * shadow_visibility(light, p, n, extra_offset);
+}
+
+// The BRDF for light arriving from l, seen from v: Lambertian albedo / pi plus, where
+// `specular` > 0, normalised Blinn-Phong with the exponent matching the roughness.
+vec3 surface_brdf(vec3 albedo, float specular, float roughness, vec3 n, vec3 v, vec3 l) {
+    vec3 brdf = albedo / PI;
+    if (specular > 0.0) {
+        float r = max(roughness, 0.02);
+        float exponent = 2.0 / (r * r) - 2.0;
+        vec3 h = normalize(l + v);
+        brdf += specular * (exponent + 8.0) / (8.0 * PI) * pow(max(dot(n, h), 0.0), exponent);
+    }
+    return brdf;
 }
 #endif

@@ -21,13 +21,15 @@ vec3 material_albedo(GpuMaterial m, vec2 uv) {
     return albedo;
 }
 
-// Cut-out opacity: map_d times d (Coverage textures hold it in every channel).
+// Cut-out mask: map_d (coverage textures hold it in every channel), 1 without one.
+float material_cutout(GpuMaterial m, vec2 uv) {
+    return m.coverage_texture != NO_TEXTURE ? texture(coverage_texture, uv).r : 1.0;
+}
+
+// Opacity: map_d times d. Shadow maps and voxels hold the surfaces at least half opaque;
+// the G-buffer draws the rest too, as transmissive surfaces.
 float material_coverage(GpuMaterial m, vec2 uv) {
-    float coverage = m.albedo.a;
-    if (m.coverage_texture != NO_TEXTURE) {
-        coverage *= texture(coverage_texture, uv).r;
-    }
-    return coverage;
+    return m.albedo.a * material_cutout(m, uv);
 }
 
 // Fragments below this coverage are cut out.

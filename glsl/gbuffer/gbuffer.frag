@@ -10,6 +10,7 @@ layout(location = 2) in vec2 in_uv;
 layout(location = 0) out vec4 out_albedo;   // rgb albedo, a specular (mean Ks)
 layout(location = 1) out vec4 out_normal;   // xyz world normal facing the camera, w roughness
 layout(location = 2) out vec4 out_emission; // rgb emitted radiance
+layout(location = 3) out vec2 out_transmission; // transmittance (1 - d), index of refraction
 
 // Perturbs n by a tangent-space normal map with a cotangent frame from screen-space
 // derivatives (Schüler, "Normal mapping without precomputed tangents"), so meshes need
@@ -37,7 +38,12 @@ vec3 apply_normal_map(vec3 n) {
 
 void main() {
     GpuMaterial m = materials[draw.material];
-    if (material_coverage(m, in_uv) < CUTOUT_THRESHOLD) {
+    // Cut-outs come from map_d. With transmission (it needs the voxels), a surface with a
+    // uniform d < 1 is drawn and the GI passes the rest of the light through it; without,
+    // it counts as a cut-out below half opacity, like in the shadow maps.
+    bool transmission = (frame.flags & FLAG_TRANSMISSION) != 0u;
+    float coverage = transmission ? material_cutout(m, in_uv) : material_coverage(m, in_uv);
+    if (coverage < CUTOUT_THRESHOLD) {
         discard;
     }
     vec3 to_camera = frame.camera_position.xyz - in_world;
@@ -54,4 +60,5 @@ void main() {
     out_albedo = vec4(material_albedo(m, in_uv), specular);
     out_normal = vec4(n, m.specular.a);
     out_emission = vec4(front ? m.emission.rgb : vec3(0.0), 0.0);
+    out_transmission = vec2(transmission ? 1.0 - m.albedo.a : 0.0, m.emission.a);
 }

@@ -34,12 +34,15 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
     return lod < 1.0 ? mix(base, aniso, lod) : aniso;
 }
 
-// Front-to-back accumulation along one cone; returns premultiplied radiance (rgb) and
-// occlusion (a), with the sky behind whatever the cone leaves open.
+// Front-to-back accumulation along one cone; returns premultiplied radiance (rgb) with
+// the sky behind whatever the cone leaves open, and the occlusion seen by ambient
+// occlusion (a): each occluder weighted down with its distance d by
+// 1 / (1 + d / gi.ao_distance).
 vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod) {
     float voxel = gi.origin.w;
     float grid_size = voxel * float(gi.resolution);
     vec4 acc = vec4(0.0);
+    float ao = 0.0;
     float dist = voxel;
     while (acc.a < 0.99 && dist < gi.max_distance) {
         float diameter = max(voxel, 2.0 * tan_half * dist);
@@ -54,28 +57,51 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod) {
         float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), step_length / diameter);
         vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
         acc.rgb += (1.0 - acc.a) * rgb;
+        ao += (1.0 - acc.a) * a / (1.0 + dist / gi.ao_distance);
         acc.a += (1.0 - acc.a) * a;
         dist += step_length;
     }
     acc.rgb += (1.0 - acc.a) * frame.sky_radiance.rgb;
-    return acc;
+    return vec4(acc.rgb, ao);
 }
 
+// Fraction of the light from `dir` that reaches `origin` through the voxels within
+// `max_dist`: a soft-shadow cone, accumulating opacity only.
+float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
+    float voxel = gi.origin.w;
+    float grid_size = voxel * float(gi.resolution);
+    float occlusion = 0.0;
+    float dist = voxel;
+    while (occlusion < 0.99 && dist < max_dist) {
+        float diameter = max(voxel, 2.0 * tan_half * dist);
+        vec3 uvw = (origin + dir * dist - gi.origin.xyz) / grid_size;
+        if (any(lessThan(uvw, vec3(0.0))) || any(greaterThan(uvw, vec3(1.0)))) {
+            break;
+        }
+        float s = sample_voxels(uvw, dir, log2(diameter / voxel)).a;
+        float step_length = diameter * gi.step_factor;
+        occlusion += (1.0 - occlusion) * (1.0 - pow(1.0 - clamp(s, 0.0, 0.9999), gi.step_factor));
+        dist += step_length;
+    }
+    return 1.0 - occlusion;
+}
 
 // Cosine-weighted mean radiance over the hemisphere around n from `gi.diffuse_cones`
-// cones: one along n, the others in a ring 60 degrees from it.
-vec3 gather_diffuse(vec3 origin, vec3 n, float min_lod) {
+// cones: one along n, the others in a ring 60 degrees from it. Alpha is the ambient
+// occlusion: 1 where nothing near occludes.
+vec4 gather_diffuse(vec3 origin, vec3 n, float min_lod) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);
-    vec3 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod).rgb;
+    vec4 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod);
     float weight = 1.0;
     int ring = int(gi.diffuse_cones) - 1;
     for (int i = 0; i < ring; i++) {
         float phi = 6.2831853 * float(i) / float(ring);
         vec3 dir = normalize(0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b));
-        sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod).rgb * 0.5;
+        sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod) * 0.5;
         weight += 0.5;
     }
-    return sum / weight;
+    sum /= weight;
+    return vec4(sum.rgb, 1.0 - sum.a);
 }
 #endif

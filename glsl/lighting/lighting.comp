@@ -17,7 +17,8 @@ void main() {
     }
     float depth = texelFetch(gbuffer_depth, pixel, 0).r;
     if (depth >= 1.0) {
-        imageStore(radiance_out, pixel, vec4(frame.sky_radiance.rgb, 1.0));
+        vec3 sky = (frame.flags & FLAG_EMISSION) != 0u ? frame.sky_radiance.rgb : vec3(0.0);
+        imageStore(radiance_out, pixel, vec4(sky, 1.0));
         return;
     }
     vec4 albedo = imageLoad(gbuffer_albedo, pixel);
@@ -25,22 +26,16 @@ void main() {
     vec3 p = pixel_position(pixel, depth);
     vec3 n = normalize(normal_roughness.xyz);
     vec3 v = normalize(frame.camera_position.xyz - p);
-    // Normalised Blinn-Phong with the exponent matching the roughness.
-    float roughness = max(normal_roughness.w, 0.02);
-    float exponent = 2.0 / (roughness * roughness) - 2.0;
-    vec3 radiance = imageLoad(gbuffer_emission, pixel).rgb;
-    for (uint i = 0u; i < frame.light_count; i++) {
+    vec3 radiance = (frame.flags & FLAG_EMISSION) != 0u ? imageLoad(gbuffer_emission, pixel).rgb : vec3(0.0);
+    // With soft-shadow cones the GI gather adds the direct light, shadowed through the voxels.
+    bool direct = (frame.flags & (FLAG_DIRECT | FLAG_SHADOW_CONES)) == FLAG_DIRECT;
+    for (uint i = 0u; direct && i < frame.light_count; i++) {
         vec3 l;
         vec3 e = light_irradiance(lights[i], p, n, 0.0, l);
         if (all(equal(e, vec3(0.0)))) {
             continue;
         }
-        vec3 brdf = albedo.rgb / PI;
-        if (albedo.a > 0.0) {
-            vec3 h = normalize(l + v);
-            brdf += albedo.a * (exponent + 8.0) / (8.0 * PI) * pow(max(dot(n, h), 0.0), exponent);
-        }
-        radiance += brdf * e;
+        radiance += surface_brdf(albedo.rgb, albedo.a, normal_roughness.w, n, v, l) * e;
     }
     imageStore(radiance_out, pixel, vec4(radiance, 1.0));
 }

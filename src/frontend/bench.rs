@@ -67,7 +67,7 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
         height: args.size.1,
     };
     let offscreen = Offscreen::new(&ctx, extent)?;
-    let mut settings = args.common.render_settings();
+    let mut settings = args.common.render_settings(&scene.gi)?;
     // Every pass runs every frame, so that the table shows what each one costs.
     settings.cache_shadows = false;
     let mut renderer = Renderer::new(&ctx, scene, settings, extent, super::LDR_FORMAT)?;

@@ -37,18 +37,13 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
     let format = output_format(&args.output)?;
     let ctx = create_context(&args.common, Vec::new())?;
     let scene = load_scene(&args.common)?;
+    let settings = args.common.render_settings(&scene.gi)?;
     let extent = vk::Extent2D {
         width: args.size.0,
         height: args.size.1,
     };
     let offscreen = Offscreen::new(&ctx, extent)?;
-    let mut renderer = Renderer::new(
-        &ctx,
-        scene,
-        args.common.render_settings(),
-        extent,
-        super::LDR_FORMAT,
-    )?;
+    let mut renderer = Renderer::new(&ctx, scene, settings, extent, super::LDR_FORMAT)?;
     let radiance = Buffer::new(
         &ctx,
         "radiance readback",

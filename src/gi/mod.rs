@@ -5,6 +5,7 @@
 //! shading) -> filter (anisotropic mips) -> cone trace (after the direct lighting).
 
 mod cone_trace;
+mod debug;
 mod filter;
 mod inject;
 #[cfg(test)]
@@ -73,6 +74,70 @@ pub struct ConeSettings {
     pub indirect_scale: u32,
     /// After the first frame, add one bounce per frame on top of the last frame's.
     pub accumulate_bounces: bool,
+    /// Full aperture of the soft-shadow cones, degrees: the angular size of the lights.
+    pub shadow_aperture_deg: f32,
+    /// Ambient occlusion halves for occluders this many voxels away.
+    pub ao_distance_voxels: f32,
+}
+
+impl ConeSettings {
+    /// Checks every setting's range; errors name the command-line option and the scene
+    /// file key.
+    pub fn check(&self) -> Result<()> {
+        let floats = [
+            (
+                self.diffuse_aperture_deg,
+                1.0,
+                179.0,
+                "--diffuse-aperture / diffuse_aperture_deg",
+            ),
+            (self.step_factor, 0.05, 2.0, "--step-factor / step_factor"),
+            (
+                self.shadow_aperture_deg,
+                0.1,
+                90.0,
+                "--shadow-aperture / shadow_aperture_deg",
+            ),
+            (
+                self.ao_distance_voxels,
+                0.1,
+                1024.0,
+                "--ao-distance / ao_distance_voxels",
+            ),
+        ];
+        for (value, min, max, name) in floats {
+            if !(min..=max).contains(&value) {
+                bail!("{name} must be between {min} and {max}, got {value}");
+            }
+        }
+        let counts = [
+            (self.diffuse_cones, 1, 16, "--diffuse-cones / diffuse_cones"),
+            (self.bounces, 1, 8, "--bounces / bounces"),
+            (
+                self.indirect_scale,
+                1,
+                8,
+                "--indirect-scale / indirect_scale",
+            ),
+        ];
+        for (value, min, max, name) in counts {
+            if !(min..=max).contains(&value) {
+                bail!("{name} must be between {min} and {max}, got {value}");
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Voxels per axis unless the command line or the scene file says otherwise.
+pub const DEFAULT_VOXELS: u32 = 64;
+
+/// Checks a grid resolution.
+pub fn check_voxels(resolution: u32) -> Result<()> {
+    if !resolution.is_power_of_two() || !(4..=1024).contains(&resolution) {
+        bail!("--voxels / voxels must be a power of two between 4 and 1024, got {resolution}");
+    }
+    Ok(())
 }
 
 impl Default for ConeSettings {
@@ -84,6 +149,8 @@ impl Default for ConeSettings {
             bounces: 8,
             indirect_scale: 2,
             accumulate_bounces: true,
+            shadow_aperture_deg: 4.0,
+            ao_distance_voxels: 4.0,
         }
     }
 }
@@ -96,6 +163,10 @@ struct Volumes {
     radiance: Image,
     /// Direct light only, the starting point of each bounce.
     direct: Image,
+    /// The static meshes' albedo, normal and emission, kept to start each frame's
+    /// voxelization of the moving meshes from (only when the scene has moving meshes and
+    /// the static voxels are not re-voxelized every frame).
+    static_packed: Option<[Image; 3]>,
     /// +X -X +Y -Y +Z -Z side by side along x, each resolution / 2 with a full mip chain:
     /// one texture, so that a cone picks its volume by coordinate (descriptor arrays need
     /// constant indices on lavapipe, and branching over six textures costs twice as much).
@@ -103,10 +174,19 @@ struct Volumes {
 }
 
 const PACKED_FORMAT: vk::Format = vk::Format::R32_UINT;
+/// The packed volumes after injection: read, and the normals turned to their lit side.
+const PACKED_AFTER_INJECT: ImageUse = ImageUse {
+    layout: vk::ImageLayout::GENERAL,
+    stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+    access: vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::SHADER_STORAGE_READ.as_raw()
+            | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
+    ),
+};
 const RADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
 impl Volumes {
-    fn new(ctx: &Arc<Context>, n: u32) -> Result<Self> {
+    fn new(ctx: &Arc<Context>, n: u32, static_copies: bool) -> Result<Self> {
         // Every volume can be copied out, for the checks against the CPU twins.
         let packed_usage = vk::ImageUsageFlags::STORAGE
             | vk::ImageUsageFlags::TRANSFER_DST
@@ -119,7 +199,17 @@ impl Volumes {
             ImageDesc::d3(RADIANCE_FORMAT, n / 2, n.trailing_zeros(), radiance_usage);
         directional_desc.extent.width = 6 * (n / 2);
         let directional = Image::new(ctx, "voxel radiance directional", directional_desc)?;
+        let static_packed = static_copies
+            .then(|| -> Result<[Image; 3]> {
+                Ok([
+                    packed("static voxel albedo")?,
+                    packed("static voxel normal")?,
+                    packed("static voxel emission")?,
+                ])
+            })
+            .transpose()?;
         Ok(Self {
+            static_packed,
             albedo: packed("voxel albedo")?,
             normal: packed("voxel normal")?,
             emission: packed("voxel emission")?,
@@ -152,6 +242,14 @@ impl Volumes {
                 "voxel_radiance_directional",
                 self.directional.memory_bytes(),
             ),
+            (
+                "voxel_static_copies",
+                self.static_packed
+                    .iter()
+                    .flatten()
+                    .map(Image::memory_bytes)
+                    .sum(),
+            ),
         ]
     }
 }
@@ -181,6 +279,7 @@ fn gi_bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_GI_GBUFFER_DEPTH, sampled, all),
         Binding::new(layout::BINDING_GI_DIRECT, storage, all),
         Binding::new(layout::BINDING_GI_INDIRECT, storage, all),
+        Binding::new(layout::BINDING_GI_GBUFFER_TRANSMISSION, storage, all),
     ]
 }
 
@@ -208,11 +307,16 @@ pub struct DenseGi {
     accumulate_bounces: bool,
     /// The directional volumes hold last frame's result (with its bounces).
     history: bool,
+    /// Re-voxelize everything every frame.
+    full_update: bool,
+    /// The static meshes are in the voxels (or in `Volumes::static_packed`).
+    static_ready: bool,
     indirect_scale: u32,
     /// Gathered indirect light at reduced resolution (created with the screen targets).
     indirect: Option<Image>,
     filter: filter::FilterPass,
     cone_trace: cone_trace::ConeTracePass,
+    voxel_view: debug::VoxelViewPass,
     set: vk::DescriptorSet,
     _sets: DescriptorSets,
     _uniforms: Buffer,
@@ -228,11 +332,10 @@ impl DenseGi {
         scene: &Scene,
         resolution: u32,
         cones: ConeSettings,
+        full_update: bool,
         set_layouts: [vk::DescriptorSetLayout; 2],
     ) -> Result<Self> {
-        if !resolution.is_power_of_two() || !(4..=1024).contains(&resolution) {
-            bail!("--voxels must be a power of two between 4 and 1024, got {resolution}");
-        }
+        check_voxels(resolution)?;
         if !ctx.features.geometry_shader || !ctx.features.fragment_stores_and_atomics {
             bail!(
                 "--gi dense needs geometry shaders and fragment stores/atomics, which {} lacks",
@@ -240,7 +343,8 @@ impl DenseGi {
             );
         }
         let grid = Grid::around(scene, resolution);
-        let volumes = Volumes::new(ctx, resolution)?;
+        let moving_meshes = scene.meshes.iter().any(|m| m.animation.is_some());
+        let volumes = Volumes::new(ctx, resolution, moving_meshes && !full_update)?;
         let emission_range = scene
             .materials
             .iter()
@@ -257,6 +361,9 @@ impl DenseGi {
             max_distance: grid.voxel_size * resolution as f32 * 1.8,
             indirect_scale: cones.indirect_scale.max(1),
             diffuse_cones: cones.diffuse_cones.clamp(1, 16),
+            shadow_tan_half: (cones.shadow_aperture_deg.to_radians() * 0.5).tan(),
+            ao_distance: cones.ao_distance_voxels.max(1e-3) * grid.voxel_size,
+            ..Default::default()
         };
         let uniforms = Buffer::with_data(
             ctx,
@@ -322,10 +429,16 @@ impl DenseGi {
             bounces: cones.bounces.max(1),
             accumulate_bounces: cones.accumulate_bounces && cones.bounces > 1,
             history: false,
+            full_update,
+            static_ready: false,
             indirect_scale: cones.indirect_scale.max(1),
             indirect: None,
             filter: filter::FilterPass::new(ctx, set_layouts, &volumes)?,
             cone_trace: cone_trace::ConeTracePass::new(
+                ctx,
+                [set_layouts[0], set_layouts[1], gi_layout],
+            )?,
+            voxel_view: debug::VoxelViewPass::new(
                 ctx,
                 [set_layouts[0], set_layouts[1], gi_layout],
             )?,
@@ -373,6 +486,10 @@ impl DenseGi {
             .storage_image(layout::BINDING_GI_SCREEN, radiance.view)
             .storage_image(layout::BINDING_GI_GBUFFER_ALBEDO, gbuffer.albedo.view)
             .storage_image(layout::BINDING_GI_GBUFFER_NORMAL, gbuffer.normal.view)
+            .storage_image(
+                layout::BINDING_GI_GBUFFER_TRANSMISSION,
+                gbuffer.transmission.view,
+            )
             .sampled_image(
                 layout::BINDING_GI_GBUFFER_DEPTH,
                 gbuffer.depth.view,
@@ -406,39 +523,39 @@ impl DenseGi {
         draw: &SceneDraw,
     ) {
         let ctx = &self.ctx;
-        timer.begin(cmd, "voxelize");
-        for image in self.volumes.packed() {
-            // Last frame's injection read these; the clear may start after it.
-            image_barrier(
-                ctx,
-                cmd,
-                image.raw,
-                image.full_range(),
-                ImageUse::discard_after(ImageUse::COMPUTE_STORAGE_READ),
-                ImageUse::TRANSFER_DST,
-            );
-            let zero = vk::ClearColorValue { uint32: [0; 4] };
-            unsafe {
-                ctx.device.cmd_clear_color_image(
-                    cmd,
-                    image.raw,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &zero,
-                    &[image.full_range()],
-                )
-            };
-            image_barrier(
-                ctx,
-                cmd,
-                image.raw,
-                image.full_range(),
-                ImageUse::TRANSFER_DST,
-                voxelize::VoxelizePass::IMAGE_USE,
-            );
+        let n = self.grid.resolution;
+        if self.full_update || !self.static_ready {
+            timer.begin(cmd, "voxelize");
+            for image in self.volumes.packed() {
+                self.clear_packed(cmd, image);
+            }
+            if self.full_update {
+                self.voxelize
+                    .record(ctx, cmd, draw, self.set, n, voxelize::Meshes::All);
+            } else {
+                self.voxelize
+                    .record(ctx, cmd, draw, self.set, n, voxelize::Meshes::Static);
+                if let Some(copies) = &self.volumes.static_packed {
+                    for (image, copy) in self.volumes.packed().into_iter().zip(copies) {
+                        self.copy_packed(cmd, image, copy, ImageUse::UNDEFINED, true);
+                    }
+                    self.voxelize
+                        .record(ctx, cmd, draw, self.set, n, voxelize::Meshes::Moving);
+                }
+                self.static_ready = true;
+            }
+            timer.end(cmd);
+        } else if let Some(copies) = &self.volumes.static_packed {
+            // The moving meshes start again from the static voxels; the static meshes are
+            // not drawn.
+            timer.begin(cmd, "voxelize");
+            for (image, copy) in self.volumes.packed().into_iter().zip(copies) {
+                self.copy_packed(cmd, copy, image, ImageUse::TRANSFER_SRC, false);
+            }
+            self.voxelize
+                .record(ctx, cmd, draw, self.set, n, voxelize::Meshes::Moving);
+            timer.end(cmd);
         }
-        self.voxelize
-            .record(ctx, cmd, draw, self.set, self.grid.resolution);
-        timer.end(cmd);
 
         timer.begin(cmd, "inject");
         memory_barrier(
@@ -455,37 +572,156 @@ impl DenseGi {
         );
         // Last frame's cone tracing sampled the radiance volumes that are rewritten now.
         compute_to_compute(ctx, cmd);
-        self.inject
-            .record(cmd, draw.frame_set, self.set, self.grid.resolution);
+        self.inject.record(cmd, draw.frame_set, self.set, n);
         timer.end(cmd);
 
         let bounces = if self.history { 1 } else { self.bounces - 1 };
         if !self.history {
             timer.begin(cmd, "filter");
             compute_to_compute(ctx, cmd);
-            self.filter.record(ctx, cmd, self.grid.resolution);
+            self.filter.record(ctx, cmd, n);
             timer.end(cmd);
         }
         self.history = self.accumulate_bounces;
         for _ in 0..bounces {
             timer.begin(cmd, "bounce");
             compute_to_compute(ctx, cmd);
-            self.inject
-                .record_bounce(cmd, draw.frame_set, self.set, self.grid.resolution);
+            self.inject.record_bounce(cmd, draw.frame_set, self.set, n);
             compute_to_compute(ctx, cmd);
-            self.filter.record(ctx, cmd, self.grid.resolution);
+            self.filter.record(ctx, cmd, n);
             timer.end(cmd);
         }
     }
 
-    /// Adds the cone-traced indirect light to `radiance` (written by the lighting pass).
+    /// Zeroes a packed volume for voxelization (last frame's injection read it).
+    fn clear_packed(&self, cmd: vk::CommandBuffer, image: &Image) {
+        let ctx = &self.ctx;
+        image_barrier(
+            ctx,
+            cmd,
+            image.raw,
+            image.full_range(),
+            ImageUse::discard_after(PACKED_AFTER_INJECT),
+            ImageUse::TRANSFER_DST,
+        );
+        let zero = vk::ClearColorValue { uint32: [0; 4] };
+        unsafe {
+            ctx.device.cmd_clear_color_image(
+                cmd,
+                image.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &zero,
+                &[image.full_range()],
+            )
+        };
+        image_barrier(
+            ctx,
+            cmd,
+            image.raw,
+            image.full_range(),
+            ImageUse::TRANSFER_DST,
+            voxelize::VoxelizePass::IMAGE_USE,
+        );
+    }
+
+    /// Copies packed volume `from` to `to`. `from_working` says which one is the working
+    /// volume (voxelized just before; otherwise it is overwritten after last frame's
+    /// injection). The static copies stay in TRANSFER_SRC layout between frames;
+    /// `to_before` is the state of `to` when it is a static copy.
+    fn copy_packed(
+        &self,
+        cmd: vk::CommandBuffer,
+        from: &Image,
+        to: &Image,
+        to_before: ImageUse,
+        from_working: bool,
+    ) {
+        let ctx = &self.ctx;
+        let range = from.full_range();
+        let (from_before, to_before) = if from_working {
+            (voxelize::VoxelizePass::IMAGE_USE, to_before)
+        } else {
+            (
+                ImageUse::TRANSFER_SRC,
+                ImageUse::discard_after(PACKED_AFTER_INJECT),
+            )
+        };
+        image_barrier(
+            ctx,
+            cmd,
+            from.raw,
+            range,
+            from_before,
+            ImageUse::TRANSFER_SRC,
+        );
+        image_barrier(ctx, cmd, to.raw, range, to_before, ImageUse::TRANSFER_DST);
+        let layers = vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let region = vk::ImageCopy {
+            src_subresource: layers,
+            src_offset: vk::Offset3D::default(),
+            dst_subresource: layers,
+            dst_offset: vk::Offset3D::default(),
+            extent: from.desc.extent,
+        };
+        unsafe {
+            ctx.device.cmd_copy_image(
+                cmd,
+                from.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                to.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            )
+        };
+        let (working, copy) = if from_working { (from, to) } else { (to, from) };
+        let working_before = if from_working {
+            ImageUse::TRANSFER_SRC
+        } else {
+            ImageUse::TRANSFER_DST
+        };
+        image_barrier(
+            ctx,
+            cmd,
+            working.raw,
+            range,
+            working_before,
+            voxelize::VoxelizePass::IMAGE_USE,
+        );
+        if from_working {
+            // The static copy keeps TRANSFER_SRC for the next frames' copies.
+            image_barrier(
+                ctx,
+                cmd,
+                copy.raw,
+                range,
+                ImageUse::TRANSFER_DST,
+                ImageUse::TRANSFER_SRC,
+            );
+        }
+    }
+
+    /// Adds the cone-traced light to `radiance` (written by the lighting pass), or with
+    /// `voxel_view` overwrites it with a debug view of the voxels.
     pub fn record_gather(
         &self,
         cmd: vk::CommandBuffer,
         timer: &mut GpuTimer,
         frame_set: vk::DescriptorSet,
         extent: vk::Extent2D,
+        voxel_view: bool,
     ) {
+        if voxel_view {
+            timer.begin(cmd, "voxel_view");
+            compute_to_compute(&self.ctx, cmd);
+            self.voxel_view.record(cmd, frame_set, self.set, extent);
+            timer.end(cmd);
+            return;
+        }
         timer.begin(cmd, "cone_trace");
         compute_to_compute(&self.ctx, cmd);
         let scale = self.indirect_scale;

@@ -25,8 +25,9 @@ fn shared_scene(path: &str) -> Option<std::path::PathBuf> {
     }
 }
 
-/// Renders 64x64 frames of `scene` with `--gi dense --voxels n`, one at each time.
-fn render_at(scene: Scene, n: u32, times: &[f32]) -> (Arc<Context>, Renderer) {
+/// Renders 64x64 frames of `scene` with `--gi dense --voxels n`, one at each time,
+/// re-voxelizing the static meshes every frame with `full_update`.
+fn render_at(scene: Scene, n: u32, times: &[f32], full_update: bool) -> (Arc<Context>, Renderer) {
     // Validation messages go to the log; show them when a test fails.
     let _ = env_logger::builder().is_test(true).try_init();
     let ctx = Context::new(&ContextOptions {
@@ -38,6 +39,8 @@ fn render_at(scene: Scene, n: u32, times: &[f32]) -> (Arc<Context>, Renderer) {
         gi: Some(GiSettings {
             voxels: n,
             cones: Default::default(),
+            shadow_cones: false,
+            full_update,
         }),
         ..Default::default()
     };
@@ -73,7 +76,7 @@ fn render_at(scene: Scene, n: u32, times: &[f32]) -> (Arc<Context>, Renderer) {
 
 /// Renders one 64x64 frame of `scene` at time 0 with `--gi dense --voxels n`.
 fn render(scene: Scene, n: u32) -> (Arc<Context>, Renderer) {
-    render_at(scene, n, &[0.0])
+    render_at(scene, n, &[0.0], false)
 }
 
 fn world_triangles(scene: &Scene) -> Vec<[Vec3; 3]> {
@@ -176,6 +179,7 @@ fn filter_matches_cpu() {
     let options = LoadOptions {
         diffuse_only: true,
         no_normal_maps: true,
+        no_refraction: true,
     };
     let n = 32;
     let (ctx, renderer) = render(Scene::load(&path, &options).unwrap(), n);
@@ -218,7 +222,9 @@ fn filter_matches_cpu() {
 }
 
 /// A mesh moving across the Cornell box leaves no voxel behind: after frames at several
-/// times, the voxels equal a fresh voxelization at the last time.
+/// times, with the static voxels kept from the first frame, the voxels (occupancy and
+/// albedo) equal a fresh voxelization at the last time and a full re-voxelization of
+/// every frame.
 #[test]
 fn moving_mesh_leaves_no_voxels_behind() {
     let Some(cornell) = shared_scene("scenes/cornell_box/CornellBox-Original.obj") else {
@@ -244,17 +250,52 @@ fn moving_mesh_leaves_no_voxels_behind() {
     )
     .unwrap();
     let scene = Scene::load(&scene_file, &LoadOptions::default()).unwrap();
-    let (ctx, moved) = render_at(scene.clone(), 32, &[0.0, 0.5, 1.0]);
+    let times = [0.0, 0.5, 1.0];
+    let (ctx, moved) = render_at(scene.clone(), 32, &times, false);
     let moved_voxels = occupancy(&moved);
-    let (_, fresh) = render_at(scene.clone(), 32, &[1.0]);
+    let (_, fresh) = render_at(scene.clone(), 32, &[1.0], false);
     let fresh_voxels = occupancy(&fresh);
-    let (_, start) = render_at(scene, 32, &[0.0]);
+    let (_, full) = render_at(scene.clone(), 32, &times, true);
+    let (_, start) = render_at(scene, 32, &[0.0], false);
     let start_voxels = occupancy(&start);
     assert_ne!(start_voxels, fresh_voxels, "the cube did not move");
     assert_eq!(
         moved_voxels, fresh_voxels,
         "voxels left behind or missing after the move"
     );
+    let albedo = |r: &Renderer| r.dense_gi().unwrap().download(Volume::Albedo, 0).unwrap();
+    assert!(
+        albedo(&moved) == albedo(&fresh),
+        "albedo differs from a fresh voxelization"
+    );
+    assert!(
+        albedo(&moved) == albedo(&full),
+        "albedo differs from --full-update"
+    );
     assert_eq!(ctx.validation_messages(), 0);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Static geometry is voxelized once: later frames only shade it (a moving light needs
+/// no voxelization), unless every frame is a full update.
+#[test]
+fn static_voxels_are_voxelized_once() {
+    let Some(path) = shared_scene("reference/cornell_point.scene.json") else {
+        return;
+    };
+    let scene = Scene::load(&path, &LoadOptions::default()).unwrap();
+    let passes = |full_update| {
+        let (ctx, renderer) = render_at(scene.clone(), 32, &[0.0, 0.5], full_update);
+        assert_eq!(ctx.validation_messages(), 0);
+        renderer
+            .timings
+            .iter()
+            .map(|(name, _)| name.clone())
+            .collect::<Vec<_>>()
+    };
+    let kept = passes(false);
+    assert!(!kept.iter().any(|p| p == "voxelize"), "{kept:?}");
+    assert!(kept.iter().any(|p| p == "inject"), "{kept:?}");
+    let full = passes(true);
+    assert!(full.iter().any(|p| p == "voxelize"), "{full:?}");
 }

@@ -7,6 +7,7 @@ use anyhow::Result;
 use ash::vk;
 
 use crate::gpu_layout::DrawPush;
+use crate::scene::Mesh;
 use crate::scene_gpu::{SceneDraw, VERTEX_ATTRIBUTES};
 use crate::vk::{set_viewport, Context, GraphicsDesc, ImageUse, Pipeline};
 
@@ -49,6 +50,7 @@ impl VoxelizePass {
         Ok(Self { pipeline })
     }
 
+    /// Voxelizes the meshes of `which` into an `n`³ grid.
     pub fn record(
         &self,
         ctx: &Context,
@@ -56,6 +58,7 @@ impl VoxelizePass {
         draw: &SceneDraw,
         gi_set: vk::DescriptorSet,
         n: u32,
+        which: Meshes,
     ) {
         let extent = vk::Extent2D {
             width: n,
@@ -69,7 +72,22 @@ impl VoxelizePass {
             .layer_count(1);
         unsafe { ctx.device.cmd_begin_rendering(cmd, &rendering) };
         set_viewport(ctx, cmd, extent);
-        draw.draw_meshes(ctx, cmd, &self.pipeline, 0, Some(gi_set));
+        let keep = |mesh: &Mesh| match which {
+            Meshes::All => true,
+            Meshes::Static => mesh.animation.is_none(),
+            Meshes::Moving => mesh.animation.is_some(),
+        };
+        draw.draw_meshes_where(ctx, cmd, &self.pipeline, 0, Some(gi_set), keep);
         unsafe { ctx.device.cmd_end_rendering(cmd) };
     }
+}
+
+/// Which meshes a voxelization draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Meshes {
+    All,
+    /// Those without animation.
+    Static,
+    /// Those with animation.
+    Moving,
 }

@@ -45,6 +45,17 @@
 //!
 //! [sky]                          # optional
 //! radiance = [0.3, 0.35, 0.45]   # constant environment radiance, default zero
+//!
+//! [gi]                           # optional; each key as its command-line option, which wins
+//! voxels = 64                    # --voxels
+//! diffuse_cones = 6              # --diffuse-cones
+//! diffuse_aperture_deg = 60.0    # --diffuse-aperture
+//! step_factor = 0.5              # --step-factor
+//! bounces = 8                    # --bounces
+//! indirect_scale = 2             # --indirect-scale
+//! shadow_cones = false           # --shadow-cones
+//! shadow_aperture_deg = 4.0      # --shadow-aperture
+//! ao_distance_voxels = 4.0       # --ao-distance
 //! ```
 //!
 //! `spin` turns about the centre of the entry's object-space bounds at `deg_per_s`;
@@ -75,7 +86,7 @@ use glam::{Mat4, Quat, Vec3};
 use serde::Deserialize;
 
 use super::obj::{Geometry, ObjEntry};
-use super::{Aabb, Animation, Camera, Light, LightKind, LoadOptions, Orbit, Scene};
+use super::{Aabb, Animation, Camera, GiOverrides, Light, LightKind, LoadOptions, Orbit, Scene};
 
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
@@ -86,6 +97,7 @@ struct SceneFile {
     #[serde(default)]
     light: Vec<LightSpec>,
     sky: Option<SkySpec>,
+    gi: Option<GiOverrides>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -365,6 +377,7 @@ fn load_geometry(entries: &[ObjEntry], options: &LoadOptions, source: &Path) -> 
         sky: Vec3::ZERO,
         source: source.to_path_buf(),
         triangle_count,
+        gi: GiOverrides::default(),
     })
 }
 
@@ -446,6 +459,7 @@ fn scene_from_toml(
     scene.camera = camera.unwrap_or_else(|| framing_camera(&scene.bounds(0.0)));
     scene.lights = lights;
     scene.sky = sky;
+    scene.gi = file.gi.unwrap_or_default();
     Ok(scene)
 }
 

@@ -161,6 +161,23 @@ pub struct LoadOptions {
     pub diffuse_only: bool,
     /// Ignore normal maps (they are not even loaded).
     pub no_normal_maps: bool,
+    /// Ignore Ni: transmissive surfaces (d < 1) pass light straight through.
+    pub no_refraction: bool,
+}
+
+/// GI settings a scene file may give (`[gi]`); the command line overrides them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GiOverrides {
+    pub voxels: Option<u32>,
+    pub diffuse_cones: Option<u32>,
+    pub diffuse_aperture_deg: Option<f32>,
+    pub step_factor: Option<f32>,
+    pub bounces: Option<u32>,
+    pub indirect_scale: Option<u32>,
+    pub shadow_cones: Option<bool>,
+    pub shadow_aperture_deg: Option<f32>,
+    pub ao_distance_voxels: Option<f32>,
 }
 
 #[derive(Clone, Debug)]
@@ -174,6 +191,8 @@ pub struct Scene {
     pub sky: Vec3,
     pub source: PathBuf,
     pub triangle_count: usize,
+    /// GI settings from the scene file.
+    pub gi: GiOverrides,
 }
 
 impl Scene {

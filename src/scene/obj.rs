@@ -208,7 +208,11 @@ fn convert_material(
         dissolve: dissolve.clamp(0.0, 1.0),
         coverage_texture,
         normal_texture,
-        ior: m.optical_density.unwrap_or(1.0),
+        ior: if options.no_refraction {
+            1.0
+        } else {
+            m.optical_density.unwrap_or(1.0).max(1.0)
+        },
     })
 }
 
@@ -495,6 +499,7 @@ mod tests {
         let options = LoadOptions {
             no_normal_maps: true,
             diffuse_only: true,
+            no_refraction: true,
         };
         let (_, materials, textures) = load(&obj, &options).unwrap();
         assert!(textures.is_empty() && materials.iter().all(|m| m.normal_texture.is_none()));

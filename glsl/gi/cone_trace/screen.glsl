@@ -7,6 +7,7 @@
 layout(set = SET_PASS, binding = BINDING_GI_GBUFFER_ALBEDO, rgba16f) uniform readonly image2D gbuffer_albedo;
 layout(set = SET_PASS, binding = BINDING_GI_GBUFFER_NORMAL, rgba16f) uniform readonly image2D gbuffer_normal;
 layout(set = SET_PASS, binding = BINDING_GI_GBUFFER_DEPTH) uniform sampler2D gbuffer_depth;
+layout(set = SET_PASS, binding = BINDING_GI_GBUFFER_TRANSMISSION, rg16f) uniform readonly image2D gbuffer_transmission;
 
 // The full-resolution pixel that stands for reduced-resolution pixel `low`.
 ivec2 representative(ivec2 low) {

@@ -1,27 +1,25 @@
 #version 460
-// Depth- and normal-aware upsampling of the gathered indirect light: each pixel blends
-// the four nearest reduced-resolution samples, bilinearly, down-weighting those whose
-// surface lies at another depth or faces another way, then adds albedo x gathered to
-// the direct light. Glossy pixels (Ks > 0) also trace one specular cone here, at full
-// resolution, as reflections are sharper than the diffuse light.
+// The composite of the GI terms, per pixel at full resolution:
+// - indirect diffuse: a depth- and normal-aware upsample of the gathered light (each
+//   pixel blends the four nearest reduced-resolution samples bilinearly, down-weighting
+//   those whose surface lies at another depth or faces another way), times albedo;
+// - indirect specular: one cone along the reflection for glossy pixels (Ks > 0), with
+//   the aperture from the roughness, sharper than the diffuse light;
+// - direct light shadowed by soft-shadow cones, when they replace the shadow maps;
+// - ambient occlusion on the indirect terms;
+// - transmission: transmissive pixels (d < 1) pass 1 - d of the light from one cone
+//   along the refracted ray.
+// Each term follows its FLAG_*; the debug views show the indirect light or AO alone.
 #include "gi/cones.glsl"
+#include "common/direct_light.glsl"
 #include "gi/cone_trace/screen.glsl"
 
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_INDIRECT, rgba16f) uniform readonly image2D indirect;
 layout(set = SET_PASS, binding = BINDING_GI_SCREEN, rgba32f) uniform image2D screen_radiance;
 
-void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-    if (pixel.x >= int(frame.width) || pixel.y >= int(frame.height)) {
-        return;
-    }
-    float depth = texelFetch(gbuffer_depth, pixel, 0).r;
-    if (depth >= 1.0) {
-        return;
-    }
-    vec3 p = pixel_position(pixel, depth);
-    vec3 n = normalize(imageLoad(gbuffer_normal, pixel).xyz);
+// The gathered indirect light (rgb) and ambient occlusion (a) at `pixel`, upsampled.
+vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n) {
     float scale = float(gi.indirect_scale);
     // Position in reduced-resolution pixel units, relative to sample centres.
     vec2 at = (vec2(pixel) + 0.5) / scale - 0.5;
@@ -29,7 +27,7 @@ void main() {
     vec2 f = at - vec2(base);
     ivec2 size = imageSize(indirect);
     float tolerance = 2.0 * gi.origin.w;
-    vec3 sum = vec3(0.0);
+    vec4 sum = vec4(0.0);
     float weight = 0.0;
     for (int j = 0; j < 2; j++) {
         for (int i = 0; i < 2; i++) {
@@ -45,21 +43,81 @@ void main() {
             // Off the pixel's plane by more than two voxels, or turned away: another surface.
             float plane = exp(-abs(dot(q - p, n)) / tolerance);
             float w = max(bilinear, 1e-3) * plane * pow(max(dot(n, m), 0.0), 8.0);
-            sum += w * imageLoad(indirect, low).rgb;
+            sum += w * imageLoad(indirect, low);
             weight += w;
         }
     }
-    vec3 gathered = weight > 1e-6 ? sum / weight : vec3(0.0);
-    vec4 albedo_specular = imageLoad(gbuffer_albedo, pixel);
-    vec3 indirect_light = albedo_specular.rgb * gathered;
-    float specular = albedo_specular.a;
-    if (specular > 0.0) {
-        // The cone's half-angle follows the roughness: tan(half) ~ roughness.
-        float roughness = clamp(imageLoad(gbuffer_normal, pixel).w, 0.02, 1.0);
-        vec3 v = normalize(frame.camera_position.xyz - p);
-        vec3 r = reflect(-v, n);
-        indirect_light += specular * trace_cone(p + n * (2.0 * gi.origin.w), r, roughness, 0.0).rgb;
+    return weight > 1e-6 ? sum / weight : vec4(0.0, 0.0, 0.0, 1.0);
+}
+
+bool enabled(uint flag) {
+    return (frame.flags & flag) != 0u;
+}
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (pixel.x >= int(frame.width) || pixel.y >= int(frame.height)) {
+        return;
     }
-    vec4 direct = imageLoad(screen_radiance, pixel);
-    imageStore(screen_radiance, pixel, vec4(direct.rgb + indirect_light, direct.a));
+    float depth = texelFetch(gbuffer_depth, pixel, 0).r;
+    if (depth >= 1.0) {
+        if (frame.debug_view != DEBUG_NONE) {
+            imageStore(screen_radiance, pixel, vec4(frame.debug_view == DEBUG_AO ? vec3(1.0) : vec3(0.0), 1.0));
+        }
+        return;
+    }
+    vec3 p = pixel_position(pixel, depth);
+    vec4 normal_roughness = imageLoad(gbuffer_normal, pixel);
+    vec3 n = normalize(normal_roughness.xyz);
+    vec3 v = normalize(frame.camera_position.xyz - p);
+    vec4 albedo_specular = imageLoad(gbuffer_albedo, pixel);
+    float roughness = clamp(normal_roughness.w, 0.02, 1.0);
+    vec3 start = p + n * (2.0 * gi.origin.w);
+
+    vec4 gathered = upsampled_indirect(pixel, p, n);
+    float ao = enabled(FLAG_AO) ? gathered.a : 1.0;
+    vec3 indirect_light = vec3(0.0);
+    if (enabled(FLAG_INDIRECT_DIFFUSE)) {
+        indirect_light += albedo_specular.rgb * gathered.rgb;
+    }
+    float specular = albedo_specular.a;
+    if (specular > 0.0 && enabled(FLAG_INDIRECT_SPECULAR)) {
+        // The cone's half-angle follows the roughness: tan(half) ~ roughness.
+        indirect_light += specular * trace_cone(start, reflect(-v, n), roughness, 0.0).rgb;
+    }
+    indirect_light *= ao;
+
+    vec3 surface = imageLoad(screen_radiance, pixel).rgb;
+    if (enabled(FLAG_SHADOW_CONES) && enabled(FLAG_DIRECT)) {
+        for (uint i = 0u; i < frame.light_count; i++) {
+            vec3 l;
+            float dist;
+            vec3 e = light_incident(lights[i], p, n, l, dist);
+            if (all(equal(e, vec3(0.0)))) {
+                continue;
+            }
+            float visibility = cone_visibility(start, l, gi.shadow_tan_half, dist - gi.origin.w);
+            surface += surface_brdf(albedo_specular.rgb, specular, roughness, n, v, l) * e * visibility;
+        }
+    }
+    surface += indirect_light;
+
+    vec2 transmission = imageLoad(gbuffer_transmission, pixel).rg;
+    vec3 transmitted = vec3(0.0);
+    if (transmission.r > 0.0 && enabled(FLAG_TRANSMISSION)) {
+        // n faces the camera: the ray enters the surface (relative index 1 / Ni).
+        vec3 t = refract(-v, n, 1.0 / max(transmission.g, 1.0));
+        vec3 dir = dot(t, t) > 0.0 ? t : reflect(-v, n);
+        float side = dot(dir, n) < 0.0 ? -1.0 : 1.0;
+        transmitted = transmission.r * trace_cone(p + side * n * (2.0 * gi.origin.w), dir, roughness, 0.0).rgb;
+        surface = (1.0 - transmission.r) * surface + transmitted;
+    }
+
+    vec3 result = surface;
+    if (frame.debug_view == DEBUG_INDIRECT) {
+        result = indirect_light + transmitted;
+    } else if (frame.debug_view == DEBUG_AO) {
+        result = vec3(gathered.a);
+    }
+    imageStore(screen_radiance, pixel, vec4(result, 1.0));
 }

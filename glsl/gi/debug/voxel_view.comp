@@ -1,0 +1,75 @@
+#version 460
+// Debug views of the voxels: each pixel marches its camera ray through the grid in
+// cells of 2^debug_level voxels and shows the first cell that holds geometry: its mean
+// albedo, mean normal (xyz * 0.5 + 0.5), or radiance composited front to back from the
+// anisotropic level facing the ray (the base voxels at level 0).
+#include "gi/cones.glsl"
+
+layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
+layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform readonly uimage3D voxel_albedo;
+layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform readonly uimage3D voxel_normal;
+layout(set = SET_PASS, binding = BINDING_GI_SCREEN, rgba32f) uniform writeonly image2D screen_radiance;
+
+// Mean albedo or normal of the occupied voxels of `cell` (edge `size` voxels), from at
+// most 4^3 of them; alpha is the fraction occupied.
+vec4 cell_mean(ivec3 cell, int size, bool normal) {
+    int stride = max(size / 4, 1);
+    vec3 sum = vec3(0.0);
+    float occupied = 0.0;
+    float count = 0.0;
+    for (int z = 0; z < size; z += stride) {
+        for (int y = 0; y < size; y += stride) {
+            for (int x = 0; x < size; x += stride) {
+                ivec3 v = cell * size + ivec3(x, y, z);
+                count += 1.0;
+                vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, v).r);
+                if (albedo.a > 0.0) {
+                    occupied += 1.0;
+                    sum += normal ? unpack_rgba8(imageLoad(voxel_normal, v).r).rgb : albedo.rgb;
+                }
+            }
+        }
+    }
+    return occupied > 0.0 ? vec4(sum / (255.0 * occupied), occupied / count) : vec4(0.0);
+}
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (pixel.x >= int(frame.width) || pixel.y >= int(frame.height)) {
+        return;
+    }
+    vec3 eye = frame.camera_position.xyz;
+    vec3 dir = normalize(pixel_position(pixel, 1.0) - eye);
+    int level = min(int(frame.debug_level), int(gi.directional_levels));
+    int size = 1 << level;
+    float cell = gi.origin.w * float(size);
+    int cells = int(gi.resolution) / size;
+    vec3 lo = gi.origin.xyz;
+    vec3 hi = lo + gi.origin.w * float(gi.resolution);
+    // Where the ray meets the grid's cube.
+    vec3 inv = 1.0 / dir;
+    vec3 t0 = (lo - eye) * inv;
+    vec3 t1 = (hi - eye) * inv;
+    float t_in = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
+    float t_out = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+    vec4 acc = vec4(0.0);
+    float grid_size = gi.origin.w * float(gi.resolution);
+    for (float t = t_in + 0.25 * cell; t < t_out && acc.a < 0.99; t += 0.25 * cell) {
+        vec3 at = eye + dir * t;
+        ivec3 c = clamp(ivec3(floor((at - lo) / cell)), ivec3(0), ivec3(cells - 1));
+        if (frame.debug_view == DEBUG_VOXEL_RADIANCE) {
+            // The cell's centre, so that the view shows the cells unfiltered.
+            vec3 uvw = (vec3(c) + 0.5) * cell / grid_size;
+            vec4 s = sample_voxels(uvw, dir, float(level));
+            float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), 0.25);
+            acc.rgb += (1.0 - acc.a) * (s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0));
+            acc.a += (1.0 - acc.a) * a;
+        } else {
+            vec4 mean = cell_mean(c, size, frame.debug_view == DEBUG_VOXEL_NORMAL);
+            if (mean.a > 0.0) {
+                acc = vec4(mean.rgb, 1.0);
+            }
+        }
+    }
+    imageStore(screen_radiance, pixel, vec4(acc.rgb, 1.0));
+}
