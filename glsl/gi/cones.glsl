@@ -35,14 +35,19 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
 }
 
 // Front-to-back accumulation along one cone; returns premultiplied radiance (rgb) with
-// the sky behind whatever the cone leaves open, and the occlusion seen by ambient
-// occlusion (a): each occluder weighted down with its distance d by
-// 1 / (1 + d / gi.ao_distance).
-vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod) {
+// the sky behind whatever the cone leaves open, and (a) the occlusion that ambient
+// occlusion counts, each occluder weighted down with its distance d by
+// 1 / (1 + d / gi.ao_distance). Ambient occlusion reads opacity from the one
+// directional volume `ao_volume` (0..5, or -1: none) travelling away from the surface
+// along the axis closest to its normal: the surface's own voxels are hidden from it by
+// the filter's facing weight, whereas the three volumes a slanted cone blends see them
+// edge-on, so an open plane would occlude itself.
+vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, int ao_volume) {
     float voxel = gi.origin.w;
     float grid_size = voxel * float(gi.resolution);
     vec4 acc = vec4(0.0);
     float ao = 0.0;
+    float ao_alpha = 0.0;
     float dist = voxel;
     while (acc.a < 0.99 && dist < gi.max_distance) {
         float diameter = max(voxel, 2.0 * tan_half * dist);
@@ -57,8 +62,13 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod) {
         float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), step_length / diameter);
         vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
         acc.rgb += (1.0 - acc.a) * rgb;
-        ao += (1.0 - acc.a) * a / (1.0 + dist / gi.ao_distance);
         acc.a += (1.0 - acc.a) * a;
+        if (ao_volume >= 0) {
+            float o = sample_directional(ao_volume, uvw, max(lod - 1.0, 0.0)).a;
+            o = 1.0 - pow(1.0 - clamp(o, 0.0, 0.9999), gi.step_factor);
+            ao += (1.0 - ao_alpha) * o / (1.0 + dist / gi.ao_distance);
+            ao_alpha += (1.0 - ao_alpha) * o;
+        }
         dist += step_length;
     }
     acc.rgb += (1.0 - acc.a) * frame.sky_radiance.rgb;
@@ -87,18 +97,24 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
 }
 
 // Cosine-weighted mean radiance over the hemisphere around n from `gi.diffuse_cones`
-// cones: one along n, the others in a ring 60 degrees from it. Alpha is the ambient
-// occlusion: 1 where nothing near occludes.
-vec4 gather_diffuse(vec3 origin, vec3 n, float min_lod) {
+// cones from `origin`: one along n, the others in a ring 60 degrees from it. With
+// `with_ao`, alpha is the ambient occlusion (1 where nothing near occludes); else 1.
+vec4 gather_diffuse(vec3 origin, vec3 n, float min_lod, bool with_ao) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);
-    vec4 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod);
+    int ao_volume = -1;
+    if (with_ao) {
+        vec3 m = abs(n);
+        int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
+        ao_volume = 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
+    }
+    vec4 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod, ao_volume);
     float weight = 1.0;
     int ring = int(gi.diffuse_cones) - 1;
     for (int i = 0; i < ring; i++) {
         float phi = 6.2831853 * float(i) / float(ring);
         vec3 dir = normalize(0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b));
-        sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod) * 0.5;
+        sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod, ao_volume) * 0.5;
         weight += 0.5;
     }
     sum /= weight;

@@ -2,7 +2,10 @@
 //!
 //! Controls: drag with the left mouse button to look around, W/A/S/D to move, Q/E to
 //! go down/up, Shift to move faster; arrow keys move the first light in X/Z and
-//! PageUp/PageDown in Y; G turns the indirect light (`--gi dense`) off and on; Escape quits.
+//! PageUp/PageDown in Y; Escape quits. With `--gi dense`: G turns the GI off and on;
+//! 1 to 6 switch the terms (direct, indirect diffuse, indirect specular, transmission,
+//! ambient occlusion, emission); C switches between shadow maps and soft-shadow cones;
+//! V cycles the debug views and [ / ] pick the voxel views' mip level.
 
 use std::collections::HashSet;
 use std::ffi::CStr;
@@ -22,7 +25,7 @@ use winit::window::{Window, WindowId};
 
 use super::{check_validation, create_context, load_scene};
 use crate::cli::ViewArgs;
-use crate::renderer::{copy_image_to_buffer, OutputTarget, Renderer};
+use crate::renderer::{copy_image_to_buffer, DebugView, OutputTarget, Renderer};
 use crate::vk::{Acquired, Buffer, Context, ImageUse, Swapchain};
 
 /// Everything that exists while the window is open.
@@ -287,6 +290,55 @@ impl Viewer {
         }
     }
 
+    /// Handles a key that switches something; returns what it did.
+    fn switch(&mut self, code: KeyCode) -> Option<String> {
+        let renderer = &mut self.renderer;
+        if code == KeyCode::KeyG {
+            let on = renderer.toggle_indirect();
+            return Some(format!(
+                "indirect light {}",
+                if on {
+                    "on"
+                } else {
+                    "off (start with --gi dense to have it)"
+                }
+            ));
+        }
+        let settings = &mut renderer.settings;
+        let gi = settings.gi.as_mut()?;
+        let terms = &mut settings.terms;
+        let (name, on) = match code {
+            KeyCode::Digit1 => ("direct light", &mut terms.direct),
+            KeyCode::Digit2 => ("indirect diffuse light", &mut terms.indirect_diffuse),
+            KeyCode::Digit3 => ("indirect specular light", &mut terms.indirect_specular),
+            KeyCode::Digit4 => ("transmission", &mut terms.transmission),
+            KeyCode::Digit5 => ("ambient occlusion", &mut terms.ambient_occlusion),
+            KeyCode::Digit6 => ("emission", &mut terms.emission),
+            KeyCode::KeyC => ("soft-shadow cones", &mut gi.shadow_cones),
+            KeyCode::KeyV => {
+                let views = DebugView::ALL;
+                let next = views
+                    .iter()
+                    .position(|v| *v == settings.debug_view)
+                    .map_or(0, |i| (i + 1) % views.len());
+                settings.debug_view = views[next];
+                return Some(format!("debug view: {:?}", settings.debug_view));
+            }
+            KeyCode::BracketLeft | KeyCode::BracketRight => {
+                let level = &mut settings.debug_level;
+                *level = if code == KeyCode::BracketLeft {
+                    level.saturating_sub(1)
+                } else {
+                    (*level + 1).min(gi.voxels.trailing_zeros())
+                };
+                return Some(format!("voxel view mip level {level}"));
+            }
+            _ => return None,
+        };
+        *on = !*on;
+        Some(format!("{name} {}", if *on { "on" } else { "off" }))
+    }
+
     fn look(&mut self, dx: f32, dy: f32) {
         let camera = &mut self.renderer.camera;
         let forward = camera.target - camera.position;
@@ -394,17 +446,11 @@ impl ApplicationHandler for App {
                         ElementState::Pressed => {
                             if code == KeyCode::Escape {
                                 event_loop.exit();
-                            } else if code == KeyCode::KeyG && !event.repeat {
-                                if let Some(viewer) = self.viewer.as_mut() {
-                                    let on = viewer.renderer.toggle_indirect();
-                                    log::info!(
-                                        "indirect light {}",
-                                        if on {
-                                            "on"
-                                        } else {
-                                            "off (start with --gi dense to have it)"
-                                        }
-                                    );
+                            } else if !event.repeat {
+                                if let Some(message) =
+                                    self.viewer.as_mut().and_then(|v| v.switch(code))
+                                {
+                                    log::info!("{message}");
                                 }
                             }
                             self.keys.insert(code);

@@ -26,5 +26,7 @@ void main() {
     // Start two voxels off the surface so the cones do not gather their own voxels, and
     // sample no finer than 2-voxel cells (the base level adds nothing measurable here:
     // Cornell box LDR-FLIP 0.1801 either way).
-    imageStore(indirect, low, gather_diffuse(p + n * (2.0 * gi.origin.w), n, 1.0));
+    // Ambient occlusion costs one more sample per step: only when shown or applied.
+    bool with_ao = (frame.flags & FLAG_AO) != 0u || frame.debug_view == DEBUG_AO;
+    imageStore(indirect, low, gather_diffuse(p + n * (2.0 * gi.origin.w), n, 1.0, with_ao));
 }

@@ -83,7 +83,7 @@ void main() {
     float specular = albedo_specular.a;
     if (specular > 0.0 && enabled(FLAG_INDIRECT_SPECULAR)) {
         // The cone's half-angle follows the roughness: tan(half) ~ roughness.
-        indirect_light += specular * trace_cone(start, reflect(-v, n), roughness, 0.0).rgb;
+        indirect_light += specular * trace_cone(start, reflect(-v, n), roughness, 0.0, -1).rgb;
     }
     indirect_light *= ao;
 
@@ -109,7 +109,7 @@ void main() {
         vec3 t = refract(-v, n, 1.0 / max(transmission.g, 1.0));
         vec3 dir = dot(t, t) > 0.0 ? t : reflect(-v, n);
         float side = dot(dir, n) < 0.0 ? -1.0 : 1.0;
-        transmitted = transmission.r * trace_cone(p + side * n * (2.0 * gi.origin.w), dir, roughness, 0.0).rgb;
+        transmitted = transmission.r * trace_cone(p + side * n * (2.0 * gi.origin.w), dir, roughness, 0.0, -1).rgb;
         surface = (1.0 - transmission.r) * surface + transmitted;
     }
 
