@@ -358,4 +358,33 @@ mod tests {
         let text = err.to_string();
         assert!(text.contains("magic") && text.contains("off"), "{text}");
     }
+
+    #[test]
+    fn command_line_wins_over_the_scene_file_over_the_defaults() {
+        let scene = GiOverrides {
+            voxels: Some(32),
+            diffuse_cones: Some(9),
+            shadow_cones: Some(true),
+            ..Default::default()
+        };
+        let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
+            Some(Command::Render(r)) => r.common.render_settings(&scene).unwrap(),
+            _ => unreachable!(),
+        };
+        let gi = parse(&["voxcone", "render"]).gi.unwrap();
+        assert_eq!((gi.voxels, gi.cones.diffuse_cones), (32, 9));
+        assert!(gi.shadow_cones);
+        assert_eq!(gi.cones.step_factor, ConeSettings::default().step_factor);
+        let gi = parse(&[
+            "voxcone",
+            "render",
+            "--voxels",
+            "16",
+            "--diffuse-cones",
+            "4",
+        ])
+        .gi
+        .unwrap();
+        assert_eq!((gi.voxels, gi.cones.diffuse_cones), (16, 4));
+    }
 }

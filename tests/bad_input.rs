@@ -140,3 +140,44 @@ fn no_vulkan_driver() {
         "no install hint: {err}"
     );
 }
+
+#[test]
+fn bad_gi_settings_in_scene_file() {
+    let dir = temp_dir("bad_gi_settings");
+    write(&dir, "t.obj", TRIANGLE);
+    let scene = write(
+        &dir,
+        "scene.toml",
+        "[[mesh]]\npath = \"t.obj\"\n[gi]\nvoxels = 48\n",
+    );
+    assert_fails_naming(&["render", &scene], &["voxels", "power of two", "48"]);
+    let scene = write(
+        &dir,
+        "typo.toml",
+        "[[mesh]]\npath = \"t.obj\"\n[gi]\nvoxel = 64\n",
+    );
+    assert_fails_naming(
+        &["render", &scene],
+        &["typo.toml", "unknown field", "voxel"],
+    );
+    let scene = write(
+        &dir,
+        "cones.toml",
+        "[[mesh]]\npath = \"t.obj\"\n[gi]\ndiffuse_cones = 40\n",
+    );
+    assert_fails_naming(
+        &["render", &scene],
+        &["diffuse_cones", "between 1 and 16", "40"],
+    );
+}
+
+#[test]
+fn voxel_options_without_voxels() {
+    for option in ["--shadow-cones", "--full-update"] {
+        assert_fails_naming(&["render", "--gi", "off", option], &[option, "--gi dense"]);
+    }
+    assert_fails_naming(
+        &["render", "--gi", "off", "--debug-view", "ao"],
+        &["--debug-view", "--gi dense"],
+    );
+}
