@@ -72,6 +72,11 @@ gpu_layout! {
         BINDING_GI_INDIRECT = 12;
         /// GI passes (set 2): G-buffer transmittance (r) and index of refraction (g), `rg16f` storage.
         BINDING_GI_GBUFFER_TRANSMISSION = 13;
+        /// GI passes (set 2): soft-shadow cone visibility of lights 0..`CONE_SHADOW_LIGHTS` at reduced resolution, `rgba16f` storage.
+        BINDING_GI_SHADOW = 14;
+        /// Lights whose soft-shadow cones are traced at the reduced resolution of the
+        /// indirect light (one channel each); further lights trace theirs per pixel.
+        CONE_SHADOW_LIGHTS = 4;
         /// filter pass (set 2): the base radiance, read by the first level, `rgba16f` storage.
         BINDING_FILTER_BASE = 0;
         /// filter pass (set 2): the directional level read (levels after the first), `rgba16f` storage.

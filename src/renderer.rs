@@ -589,7 +589,15 @@ impl Renderer {
                     .map(|m| self.scene.mesh_transform(m, time_s).to_cols_array_2d()),
             )
             .collect();
-        if !(self.settings.cache_shadows && self.shadow_inputs.as_ref() == Some(&inputs)) {
+        // Soft-shadow cones need no shadow maps (the voxels are lit by a voxel ray-march
+        // then); they are rendered once all the same, so that they are valid when the
+        // viewer switches back.
+        let maps_needed = !self
+            .settings
+            .gi
+            .is_some_and(|g| g.shadow_cones && self.indirect);
+        let stale = !(self.settings.cache_shadows && self.shadow_inputs.as_ref() == Some(&inputs));
+        if self.shadow_inputs.is_none() || (maps_needed && stale) {
             timer.begin(cmd, "shadow");
             self.shadow.record(&ctx, cmd, &draw, &views);
             timer.end(cmd);

@@ -24,10 +24,10 @@ uint shadow_view_for(GpuLight light, vec3 p) {
     return light.first_shadow_view + face;
 }
 
-// Fraction of the light reaching p (normal n), 5x5 PCF over bilinear depth compares.
-// `extra_offset` moves p further along n (voxel centres lie up to half a voxel inside
-// their surface).
-float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset) {
+// Fraction of the light reaching p (normal n), PCF over (2 pcf_radius + 1)^2 bilinear
+// depth compares. `extra_offset` moves p further along n (voxel centres lie up to half a
+// voxel inside their surface).
+float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset, int pcf_radius) {
     if (light.shadow_view_count == 0u) {
         return 1.0;
     }
@@ -41,12 +41,13 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset) {
     vec2 uv = ndc.xy * 0.5 + 0.5;
     vec2 texel_uv = 1.0 / vec2(textureSize(shadow_map, 0).xy);
     float sum = 0.0;
-    for (int y = -2; y <= 2; y++) {
-        for (int x = -2; x <= 2; x++) {
+    for (int y = -pcf_radius; y <= pcf_radius; y++) {
+        for (int x = -pcf_radius; x <= pcf_radius; x++) {
             sum += texture(shadow_map, vec4(uv + vec2(x, y) * texel_uv, float(view.layer), ndc.z));
         }
     }
-    return sum / 25.0;
+    float taps = float(2 * pcf_radius + 1);
+    return sum / (taps * taps);
 }
 
 // Irradiance at p (normal n) from one light, unshadowed, the unit vector towards it and
@@ -71,14 +72,15 @@ vec3 light_incident(GpuLight light, vec3 p, vec3 n, out vec3 to_light, out float
     return e * max(dot(n, to_light), 0.0);
 }
 
-// Irradiance at p (normal n) from one light, shadowed, and the unit vector towards it.
-vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, float extra_offset, out vec3 to_light) {
+// Irradiance at a surface point p (normal n) from one light, shadowed (5x5 PCF), and the
+// unit vector towards it.
+vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, out vec3 to_light) {
     float dist;
     vec3 e = light_incident(light, p, n, to_light, dist);
     if (all(equal(e, vec3(0.0)))) {
         return e;
     }
-    return e * shadow_visibility(light, p, n, extra_offset);
+    return e * shadow_visibility(light, p, n, 0.0, 2);
 }
 
 // The BRDF for light arriving from l, seen from v: Lambertian albedo / pi plus, where

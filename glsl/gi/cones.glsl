@@ -96,10 +96,10 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
     return 1.0 - occlusion;
 }
 
-// Cosine-weighted mean radiance over the hemisphere around n from `gi.diffuse_cones`
-// cones from `origin`: one along n, the others in a ring 60 degrees from it. With
-// `with_ao`, alpha is the ambient occlusion (1 where nothing near occludes); else 1.
-vec4 gather_diffuse(vec3 origin, vec3 n, float min_lod, bool with_ao) {
+// Cosine-weighted mean radiance over the hemisphere around n from `cones` cones from
+// `origin`: one along n, the others in a ring 60 degrees from it. With `with_ao`, alpha
+// is the ambient occlusion (1 where nothing near occludes); else 1.
+vec4 gather_diffuse(vec3 origin, vec3 n, int cones, float min_lod, bool with_ao) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);
     int ao_volume = -1;
@@ -110,7 +110,7 @@ vec4 gather_diffuse(vec3 origin, vec3 n, float min_lod, bool with_ao) {
     }
     vec4 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod, ao_volume);
     float weight = 1.0;
-    int ring = int(gi.diffuse_cones) - 1;
+    int ring = cones - 1;
     for (int i = 0; i < ring; i++) {
         float phi = 6.2831853 * float(i) / float(ring);
         vec3 dir = normalize(0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b));

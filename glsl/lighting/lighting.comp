@@ -31,7 +31,7 @@ void main() {
     bool direct = (frame.flags & (FLAG_DIRECT | FLAG_SHADOW_CONES)) == FLAG_DIRECT;
     for (uint i = 0u; direct && i < frame.light_count; i++) {
         vec3 l;
-        vec3 e = light_irradiance(lights[i], p, n, 0.0, l);
+        vec3 e = light_irradiance(lights[i], p, n, l);
         if (all(equal(e, vec3(0.0)))) {
             continue;
         }

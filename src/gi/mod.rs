@@ -254,6 +254,14 @@ impl Volumes {
     }
 }
 
+/// What the cone tracer writes at reduced resolution and the upsample reads.
+struct LowRes {
+    /// Gathered indirect light (rgb) and ambient occlusion (a).
+    indirect: Image,
+    /// Soft-shadow cone visibility of the first `CONE_SHADOW_LIGHTS` lights.
+    shadow: Image,
+}
+
 /// The set-2 bindings every GI pass shares.
 fn gi_bindings() -> Vec<Binding> {
     let all = vk::ShaderStageFlags::FRAGMENT
@@ -280,6 +288,7 @@ fn gi_bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_GI_DIRECT, storage, all),
         Binding::new(layout::BINDING_GI_INDIRECT, storage, all),
         Binding::new(layout::BINDING_GI_GBUFFER_TRANSMISSION, storage, all),
+        Binding::new(layout::BINDING_GI_SHADOW, storage, all),
     ]
 }
 
@@ -312,8 +321,8 @@ pub struct DenseGi {
     /// The static meshes are in the voxels (or in `Volumes::static_packed`).
     static_ready: bool,
     indirect_scale: u32,
-    /// Gathered indirect light at reduced resolution (created with the screen targets).
-    indirect: Option<Image>,
+    /// Created with the screen targets.
+    low_res: Option<LowRes>,
     filter: filter::FilterPass,
     cone_trace: cone_trace::ConeTracePass,
     voxel_view: debug::VoxelViewPass,
@@ -432,7 +441,7 @@ impl DenseGi {
             full_update,
             static_ready: false,
             indirect_scale: cones.indirect_scale.max(1),
-            indirect: None,
+            low_res: None,
             filter: filter::FilterPass::new(ctx, set_layouts, &volumes)?,
             cone_trace: cone_trace::ConeTracePass::new(
                 ctx,
@@ -460,29 +469,38 @@ impl DenseGi {
         depth_sampler: vk::Sampler,
     ) -> Result<()> {
         let extent = gbuffer.extent();
-        let indirect = Image::new(
-            &self.ctx,
-            "indirect",
-            ImageDesc::d2(
-                RADIANCE_FORMAT,
-                extent.width.div_ceil(self.indirect_scale),
-                extent.height.div_ceil(self.indirect_scale),
-                vk::ImageUsageFlags::STORAGE,
-            ),
-        )?;
-        OneShot::new(&self.ctx)?.run("indirect layout", |cmd| {
-            image_barrier(
+        let low = |name| {
+            Image::new(
                 &self.ctx,
-                cmd,
-                indirect.raw,
-                indirect.full_range(),
-                ImageUse::UNDEFINED,
-                ImageUse::COMPUTE_WRITE,
-            );
+                name,
+                ImageDesc::d2(
+                    RADIANCE_FORMAT,
+                    extent.width.div_ceil(self.indirect_scale),
+                    extent.height.div_ceil(self.indirect_scale),
+                    vk::ImageUsageFlags::STORAGE,
+                ),
+            )
+        };
+        let low_res = LowRes {
+            indirect: low("indirect")?,
+            shadow: low("cone shadow")?,
+        };
+        OneShot::new(&self.ctx)?.run("reduced-resolution layouts", |cmd| {
+            for image in [&low_res.indirect, &low_res.shadow] {
+                image_barrier(
+                    &self.ctx,
+                    cmd,
+                    image.raw,
+                    image.full_range(),
+                    ImageUse::UNDEFINED,
+                    ImageUse::COMPUTE_WRITE,
+                );
+            }
             Ok(())
         })?;
         SetWriter::new(&self.ctx, self.set)
-            .storage_image(layout::BINDING_GI_INDIRECT, indirect.view)
+            .storage_image(layout::BINDING_GI_INDIRECT, low_res.indirect.view)
+            .storage_image(layout::BINDING_GI_SHADOW, low_res.shadow.view)
             .storage_image(layout::BINDING_GI_SCREEN, radiance.view)
             .storage_image(layout::BINDING_GI_GBUFFER_ALBEDO, gbuffer.albedo.view)
             .storage_image(layout::BINDING_GI_GBUFFER_NORMAL, gbuffer.normal.view)
@@ -497,7 +515,7 @@ impl DenseGi {
                 vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
             )
             .apply();
-        self.indirect = Some(indirect);
+        self.low_res = Some(low_res);
         Ok(())
     }
 

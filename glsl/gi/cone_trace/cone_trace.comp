@@ -4,11 +4,13 @@
 // are marched front to back through the voxel radiance, the sky filling what they leave
 // unoccluded; alpha holds the ambient occlusion. The upsample pass spreads the result to
 // every pixel.
+#include "common/direct_light.glsl"
 #include "gi/cones.glsl"
 #include "gi/cone_trace/screen.glsl"
 
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_INDIRECT, rgba16f) uniform writeonly image2D indirect;
+layout(set = SET_PASS, binding = BINDING_GI_SHADOW, rgba16f) uniform writeonly image2D shadow;
 
 void main() {
     ivec2 low = ivec2(gl_GlobalInvocationID.xy);
@@ -28,5 +30,19 @@ void main() {
     // Cornell box LDR-FLIP 0.1801 either way).
     // Ambient occlusion costs one more sample per step: only when shown or applied.
     bool with_ao = (frame.flags & FLAG_AO) != 0u || frame.debug_view == DEBUG_AO;
-    imageStore(indirect, low, gather_diffuse(p + n * (2.0 * gi.origin.w), n, 1.0, with_ao));
+    vec3 start = p + n * (2.0 * gi.origin.w);
+    imageStore(indirect, low, gather_diffuse(start, n, int(gi.diffuse_cones), 1.0, with_ao));
+    // Soft shadows change at the scale of the voxels, like the indirect light: their
+    // cones are traced here too, for the first lights.
+    if ((frame.flags & FLAG_SHADOW_CONES) != 0u) {
+        vec4 visibility = vec4(1.0);
+        for (uint i = 0u; i < min(frame.light_count, CONE_SHADOW_LIGHTS); i++) {
+            vec3 l;
+            float dist;
+            if (any(greaterThan(light_incident(lights[i], p, n, l, dist), vec3(0.0)))) {
+                visibility[i] = cone_visibility(start, l, gi.shadow_tan_half, dist - gi.origin.w);
+            }
+        }
+        imageStore(shadow, low, visibility);
+    }
 }

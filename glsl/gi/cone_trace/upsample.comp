@@ -5,7 +5,8 @@
 //   those whose surface lies at another depth or faces another way), times albedo;
 // - indirect specular: one cone along the reflection for glossy pixels (Ks > 0), with
 //   the aperture from the roughness, sharper than the diffuse light;
-// - direct light shadowed by soft-shadow cones, when they replace the shadow maps;
+// - direct light shadowed by soft-shadow cones, when they replace the shadow maps (the
+//   first lights' visibility upsampled like the indirect light);
 // - ambient occlusion on the indirect terms;
 // - transmission: transmissive pixels (d < 1) pass 1 - d of the light from one cone
 //   along the refracted ray.
@@ -16,10 +17,14 @@
 
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_INDIRECT, rgba16f) uniform readonly image2D indirect;
+layout(set = SET_PASS, binding = BINDING_GI_SHADOW, rgba16f) uniform readonly image2D shadow;
 layout(set = SET_PASS, binding = BINDING_GI_SCREEN, rgba32f) uniform image2D screen_radiance;
 
-// The gathered indirect light (rgb) and ambient occlusion (a) at `pixel`, upsampled.
-vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n) {
+// The gathered indirect light (rgb) and ambient occlusion (a) at `pixel`, upsampled, and
+// with soft-shadow cones the first lights' visibility.
+vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n, out vec4 visibility) {
+    bool cones = (frame.flags & FLAG_SHADOW_CONES) != 0u;
+    vec4 visibility_sum = vec4(0.0);
     float scale = float(gi.indirect_scale);
     // Position in reduced-resolution pixel units, relative to sample centres.
     vec2 at = (vec2(pixel) + 0.5) / scale - 0.5;
@@ -44,9 +49,13 @@ vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n) {
             float plane = exp(-abs(dot(q - p, n)) / tolerance);
             float w = max(bilinear, 1e-3) * plane * pow(max(dot(n, m), 0.0), 8.0);
             sum += w * imageLoad(indirect, low);
+            if (cones) {
+                visibility_sum += w * imageLoad(shadow, low);
+            }
             weight += w;
         }
     }
+    visibility = weight > 1e-6 ? visibility_sum / weight : vec4(1.0);
     return weight > 1e-6 ? sum / weight : vec4(0.0, 0.0, 0.0, 1.0);
 }
 
@@ -74,7 +83,8 @@ void main() {
     float roughness = clamp(normal_roughness.w, 0.02, 1.0);
     vec3 start = p + n * (2.0 * gi.origin.w);
 
-    vec4 gathered = upsampled_indirect(pixel, p, n);
+    vec4 cone_visibility_low;
+    vec4 gathered = upsampled_indirect(pixel, p, n, cone_visibility_low);
     float ao = enabled(FLAG_AO) ? gathered.a : 1.0;
     vec3 indirect_light = vec3(0.0);
     if (enabled(FLAG_INDIRECT_DIFFUSE)) {
@@ -96,7 +106,9 @@ void main() {
             if (all(equal(e, vec3(0.0)))) {
                 continue;
             }
-            float visibility = cone_visibility(start, l, gi.shadow_tan_half, dist - gi.origin.w);
+            float visibility = i < CONE_SHADOW_LIGHTS
+                ? cone_visibility_low[i]
+                : cone_visibility(start, l, gi.shadow_tan_half, dist - gi.origin.w);
             surface += surface_brdf(albedo_specular.rgb, specular, roughness, n, v, l) * e * visibility;
         }
     }

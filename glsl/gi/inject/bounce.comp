@@ -11,6 +11,10 @@ layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform readonly uima
 layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform readonly image3D voxel_direct;
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance_out;
 
+// Cones per voxel gather, whatever --diffuse-cones asks of the screen: six cover the
+// hemisphere well enough for light that is filtered again before anyone sees it.
+const int BOUNCE_CONES = 6;
+
 void main() {
     ivec3 voxel = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(voxel, ivec3(gi.resolution)))) {
@@ -24,7 +28,7 @@ void main() {
     n = length(n) > 0.2 ? normalize(n) : vec3(0.0, 1.0, 0.0);
     vec3 p = voxel_center(voxel);
     float offset = 1.5 * gi.origin.w;
-    vec3 gathered = gather_diffuse(p + n * offset, n, 1.0, false).rgb;
+    vec3 gathered = gather_diffuse(p + n * offset, n, BOUNCE_CONES, 1.0, false).rgb;
     vec4 direct = imageLoad(voxel_direct, voxel);
     imageStore(voxel_radiance_out, voxel, vec4(direct.rgb + albedo.rgb / 255.0 * gathered, direct.a));
 }

@@ -1,7 +1,9 @@
 #version 460
 // Deferred voxel shading (Villegas 2018): per occupied voxel, outgoing radiance =
-// albedo / pi * direct irradiance (shadow maps, the surface shading's units) + emission,
-// stored premultiplied by opacity.
+// albedo / pi * direct irradiance (the surface shading's units) + emission, stored
+// premultiplied by opacity. Visibility comes from the shadow maps (one bilinear compare:
+// a voxel is wider than the PCF kernel), or with soft-shadow cones, which make the
+// shadow maps unnecessary, from a ray marched through the voxels towards the light.
 #include "common/frame.glsl"
 #include "common/direct_light.glsl"
 #include "gi/voxels.glsl"
@@ -12,6 +14,36 @@ layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform uimage3D voxe
 layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform readonly uimage3D voxel_emission;
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance;
 layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform writeonly image3D voxel_direct;
+
+// Whether the segment from p (offset along n) towards the light, up to `dist`, passes no
+// occupied voxel: one sample per voxel length.
+float voxel_visibility(vec3 p, vec3 n, vec3 to_light, float dist) {
+    float voxel = gi.origin.w;
+    vec3 start = p + n * (2.0 * voxel);
+    float end = min(dist - voxel, gi.max_distance);
+    for (float t = 0.0; t < end; t += voxel) {
+        ivec3 v = ivec3(floor((start + to_light * t - gi.origin.xyz) / voxel));
+        if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(gi.resolution)))) {
+            break;
+        }
+        if ((imageLoad(voxel_albedo, v).r >> 24) != 0u) {
+            return 0.0;
+        }
+    }
+    return 1.0;
+}
+
+// Irradiance at the voxel p on its face with normal n from one light, shadowed.
+vec3 voxel_irradiance(GpuLight light, vec3 p, vec3 n) {
+    vec3 l;
+    float dist;
+    vec3 e = light_incident(light, p, n, l, dist);
+    if (all(equal(e, vec3(0.0)))) {
+        return e;
+    }
+    bool cones = (frame.flags & FLAG_SHADOW_CONES) != 0u;
+    return e * (cones ? voxel_visibility(p, n, l, dist) : shadow_visibility(light, p, n, 0.5 * gi.origin.w, 0));
+}
 
 void main() {
     ivec3 voxel = ivec3(gl_GlobalInvocationID);
@@ -31,16 +63,14 @@ void main() {
     // Opposite normals averaged in one voxel cancel; such a voxel faces every way.
     n = len > 0.2 ? n / len : vec3(0.0, 1.0, 0.0);
     vec3 p = voxel_center(voxel);
-    float half_voxel = 0.5 * gi.origin.w;
     // Surfaces are two-sided: the voxel keeps the face that receives more light (emitters
     // their winding face), and its normal is turned to that face so that the filter
     // shows this radiance only to cones that look at the face.
     vec3 front = vec3(0.0);
     vec3 back = vec3(0.0);
     for (uint i = 0u; i < frame.light_count; i++) {
-        vec3 l;
-        front += light_irradiance(lights[i], p, n, half_voxel, l);
-        back += light_irradiance(lights[i], p, -n, half_voxel, l);
+        front += voxel_irradiance(lights[i], p, n);
+        back += voxel_irradiance(lights[i], p, -n);
     }
     vec3 emission = unpack_rgba8(imageLoad(voxel_emission, voxel).r).rgb / 255.0 * gi.emission_range;
     bool back_lit = dot(back, vec3(1.0)) > dot(front, vec3(1.0)) && all(equal(emission, vec3(0.0)));
