@@ -240,6 +240,9 @@ impl Viewer {
             }
             crate::imageio::write_png(path, extent.width, extent.height, &pixels)?;
             println!("screenshot: {}", path.display());
+            if let Some(light) = self.renderer.scene.lights.first() {
+                println!("first light at {}", light.position);
+            }
         }
         Ok(())
     }
