@@ -74,6 +74,8 @@ gpu_layout! {
         BINDING_GI_GBUFFER_TRANSMISSION = 13;
         /// GI passes (set 2): soft-shadow cone visibility of lights 0..`CONE_SHADOW_LIGHTS` at reduced resolution, `rgba16f` storage.
         BINDING_GI_SHADOW = 14;
+        /// GI passes (set 2): specular cone radiance (rgb) at reduced resolution, `rgba16f` storage.
+        BINDING_GI_SPECULAR = 15;
         /// Lights whose soft-shadow cones are traced at the reduced resolution of the
         /// indirect light (one channel each); further lights trace theirs per pixel.
         CONE_SHADOW_LIGHTS = 4;

@@ -70,8 +70,8 @@ pub struct ConeSettings {
     /// Light bounces between voxels: 1 is direct light on the voxels only.
     pub bounces: u32,
     /// Indirect light is traced on one pixel of each `indirect_scale`² block and
-    /// upsampled.
-    pub indirect_scale: u32,
+    /// upsampled; `None` picks it from the image height ([`auto_indirect_scale`]).
+    pub indirect_scale: Option<u32>,
     /// After the first frame, add one bounce per frame on top of the last frame's.
     pub accumulate_bounces: bool,
     /// Full aperture of the soft-shadow cones, degrees: the angular size of the lights.
@@ -114,7 +114,7 @@ impl ConeSettings {
             (self.diffuse_cones, 1, 16, "--diffuse-cones / diffuse_cones"),
             (self.bounces, 1, 8, "--bounces / bounces"),
             (
-                self.indirect_scale,
+                self.indirect_scale.unwrap_or(1),
                 1,
                 8,
                 "--indirect-scale / indirect_scale",
@@ -127,6 +127,15 @@ impl ConeSettings {
         }
         Ok(())
     }
+}
+
+/// The default reduction of the indirect light's resolution for an image `height` pixels
+/// high: 2, or one traced pixel per 180th of the height on taller images (4 at 720 rows,
+/// 6 at 1080). Indirect diffuse light varies at the scale of the voxels, not of the
+/// pixels; this keeps the traced samples per degree of view at least those of the
+/// 256x256 quality measurements (128 rows).
+pub fn auto_indirect_scale(height: u32) -> u32 {
+    (height / 180).clamp(2, 8)
 }
 
 /// Voxels per axis unless the command line or the scene file says otherwise.
@@ -147,7 +156,7 @@ impl Default for ConeSettings {
             diffuse_cones: 6,
             step_factor: 0.5,
             bounces: 8,
-            indirect_scale: 2,
+            indirect_scale: None,
             accumulate_bounces: true,
             shadow_aperture_deg: 4.0,
             ao_distance_voxels: 4.0,
@@ -260,6 +269,8 @@ struct LowRes {
     indirect: Image,
     /// Soft-shadow cone visibility of the first `CONE_SHADOW_LIGHTS` lights.
     shadow: Image,
+    /// Specular cone radiance (before Ks).
+    specular: Image,
 }
 
 /// The set-2 bindings every GI pass shares.
@@ -289,6 +300,7 @@ fn gi_bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_GI_INDIRECT, storage, all),
         Binding::new(layout::BINDING_GI_GBUFFER_TRANSMISSION, storage, all),
         Binding::new(layout::BINDING_GI_SHADOW, storage, all),
+        Binding::new(layout::BINDING_GI_SPECULAR, storage, all),
     ]
 }
 
@@ -320,6 +332,9 @@ pub struct DenseGi {
     full_update: bool,
     /// The static meshes are in the voxels (or in `Volumes::static_packed`).
     static_ready: bool,
+    /// `ConeSettings::indirect_scale`.
+    indirect_scale_setting: Option<u32>,
+    /// The scale of the current screen targets.
     indirect_scale: u32,
     /// Created with the screen targets.
     low_res: Option<LowRes>,
@@ -328,7 +343,7 @@ pub struct DenseGi {
     voxel_view: debug::VoxelViewPass,
     set: vk::DescriptorSet,
     _sets: DescriptorSets,
-    _uniforms: Buffer,
+    uniforms: Buffer,
     /// Referenced by the GI descriptor set.
     _linear: Sampler,
     ctx: Arc<Context>,
@@ -368,7 +383,7 @@ impl DenseGi {
             step_factor: cones.step_factor,
             diffuse_tan_half: (cones.diffuse_aperture_deg.to_radians() * 0.5).tan(),
             max_distance: grid.voxel_size * resolution as f32 * 1.8,
-            indirect_scale: cones.indirect_scale.max(1),
+            indirect_scale: 0,
             diffuse_cones: cones.diffuse_cones.clamp(1, 16),
             shadow_tan_half: (cones.shadow_aperture_deg.to_radians() * 0.5).tan(),
             ao_distance: cones.ao_distance_voxels.max(1e-3) * grid.voxel_size,
@@ -440,7 +455,8 @@ impl DenseGi {
             history: false,
             full_update,
             static_ready: false,
-            indirect_scale: cones.indirect_scale.max(1),
+            indirect_scale_setting: cones.indirect_scale,
+            indirect_scale: 1,
             low_res: None,
             filter: filter::FilterPass::new(ctx, set_layouts, &volumes)?,
             cone_trace: cone_trace::ConeTracePass::new(
@@ -454,7 +470,7 @@ impl DenseGi {
             volumes,
             set,
             _sets: sets,
-            _uniforms: uniforms,
+            uniforms,
             _linear: linear,
             ctx: ctx.clone(),
         })
@@ -469,6 +485,14 @@ impl DenseGi {
         depth_sampler: vk::Sampler,
     ) -> Result<()> {
         let extent = gbuffer.extent();
+        self.indirect_scale = self
+            .indirect_scale_setting
+            .unwrap_or_else(|| auto_indirect_scale(extent.height))
+            .max(1);
+        self.uniforms.write(
+            std::mem::offset_of!(GiUniforms, indirect_scale),
+            bytemuck::bytes_of(&self.indirect_scale),
+        );
         let low = |name| {
             Image::new(
                 &self.ctx,
@@ -484,9 +508,10 @@ impl DenseGi {
         let low_res = LowRes {
             indirect: low("indirect")?,
             shadow: low("cone shadow")?,
+            specular: low("cone specular")?,
         };
         OneShot::new(&self.ctx)?.run("reduced-resolution layouts", |cmd| {
-            for image in [&low_res.indirect, &low_res.shadow] {
+            for image in [&low_res.indirect, &low_res.shadow, &low_res.specular] {
                 image_barrier(
                     &self.ctx,
                     cmd,
@@ -501,6 +526,7 @@ impl DenseGi {
         SetWriter::new(&self.ctx, self.set)
             .storage_image(layout::BINDING_GI_INDIRECT, low_res.indirect.view)
             .storage_image(layout::BINDING_GI_SHADOW, low_res.shadow.view)
+            .storage_image(layout::BINDING_GI_SPECULAR, low_res.specular.view)
             .storage_image(layout::BINDING_GI_SCREEN, radiance.view)
             .storage_image(layout::BINDING_GI_GBUFFER_ALBEDO, gbuffer.albedo.view)
             .storage_image(layout::BINDING_GI_GBUFFER_NORMAL, gbuffer.normal.view)

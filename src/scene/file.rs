@@ -52,7 +52,7 @@
 //! diffuse_aperture_deg = 60.0    # --diffuse-aperture
 //! step_factor = 0.5              # --step-factor
 //! bounces = 8                    # --bounces
-//! indirect_scale = 2             # --indirect-scale
+//! indirect_scale = 2             # --indirect-scale (default: by image height)
 //! shadow_cones = false           # --shadow-cones
 //! shadow_aperture_deg = 4.0      # --shadow-aperture
 //! ao_distance_voxels = 4.0       # --ao-distance

@@ -1,9 +1,10 @@
 #version 460
-// Indirect diffuse light by voxel cone tracing (Crassin et al. 2011): for one G-buffer
-// pixel of each indirect_scale² block, cosine-weighted cones over the normal's hemisphere
-// are marched front to back through the voxel radiance, the sky filling what they leave
-// unoccluded; alpha holds the ambient occlusion. The upsample pass spreads the result to
-// every pixel.
+// Voxel cone tracing (Crassin et al. 2011) for one G-buffer pixel of each
+// indirect_scale² block: cosine-weighted diffuse cones over the normal's hemisphere are
+// marched front to back through the voxel radiance, the sky filling what they leave
+// unoccluded (alpha: ambient occlusion); then the soft-shadow cones towards the first
+// lights and the specular cone along the reflected view ray. The upsample pass spreads
+// the results to every pixel.
 #include "common/direct_light.glsl"
 #include "gi/cones.glsl"
 #include "gi/cone_trace/screen.glsl"
@@ -11,6 +12,7 @@
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_INDIRECT, rgba16f) uniform writeonly image2D indirect;
 layout(set = SET_PASS, binding = BINDING_GI_SHADOW, rgba16f) uniform writeonly image2D shadow;
+layout(set = SET_PASS, binding = BINDING_GI_SPECULAR, rgba16f) uniform writeonly image2D specular;
 
 void main() {
     ivec2 low = ivec2(gl_GlobalInvocationID.xy);
@@ -24,7 +26,8 @@ void main() {
         return;
     }
     vec3 p = pixel_position(pixel, depth);
-    vec3 n = normalize(imageLoad(gbuffer_normal, pixel).xyz);
+    vec4 normal_roughness = imageLoad(gbuffer_normal, pixel);
+    vec3 n = normalize(normal_roughness.xyz);
     // Start two voxels off the surface so the cones do not gather their own voxels, and
     // sample no finer than 2-voxel cells (the base level adds nothing measurable here:
     // Cornell box LDR-FLIP 0.1801 either way).
@@ -44,5 +47,14 @@ void main() {
             }
         }
         imageStore(shadow, low, visibility);
+    }
+    // The specular cone too: at 64^3 voxels a reflection is no sharper than a few voxels.
+    // Its half-angle follows the roughness: tan(half) ~ roughness.
+    if (imageLoad(gbuffer_albedo, pixel).a > 0.0 && (frame.flags & FLAG_INDIRECT_SPECULAR) != 0u) {
+        vec3 v = normalize(frame.camera_position.xyz - p);
+        float roughness = clamp(normal_roughness.w, 0.02, 1.0);
+        imageStore(specular, low, trace_cone(start, reflect(-v, n), roughness, 0.0, -1));
+    } else {
+        imageStore(specular, low, vec4(0.0));
     }
 }

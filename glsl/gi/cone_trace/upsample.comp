@@ -3,8 +3,8 @@
 // - indirect diffuse: a depth- and normal-aware upsample of the gathered light (each
 //   pixel blends the four nearest reduced-resolution samples bilinearly, down-weighting
 //   those whose surface lies at another depth or faces another way), times albedo;
-// - indirect specular: one cone along the reflection for glossy pixels (Ks > 0), with
-//   the aperture from the roughness, sharper than the diffuse light;
+// - indirect specular: the cone along the reflection traced for glossy pixels (Ks > 0)
+//   at reduced resolution, upsampled like the diffuse light, times Ks;
 // - direct light shadowed by soft-shadow cones, when they replace the shadow maps (the
 //   first lights' visibility upsampled like the indirect light);
 // - ambient occlusion on the indirect terms;
@@ -18,13 +18,16 @@
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_INDIRECT, rgba16f) uniform readonly image2D indirect;
 layout(set = SET_PASS, binding = BINDING_GI_SHADOW, rgba16f) uniform readonly image2D shadow;
+layout(set = SET_PASS, binding = BINDING_GI_SPECULAR, rgba16f) uniform readonly image2D specular_low;
 layout(set = SET_PASS, binding = BINDING_GI_SCREEN, rgba32f) uniform image2D screen_radiance;
 
-// The gathered indirect light (rgb) and ambient occlusion (a) at `pixel`, upsampled, and
-// with soft-shadow cones the first lights' visibility.
-vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n, out vec4 visibility) {
+// The gathered indirect light (rgb) and ambient occlusion (a) at `pixel`, upsampled;
+// also the specular cone's radiance and, with soft-shadow cones, the first lights'
+// visibility.
+vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n, out vec4 visibility, out vec3 specular) {
     bool cones = (frame.flags & FLAG_SHADOW_CONES) != 0u;
     vec4 visibility_sum = vec4(0.0);
+    vec3 specular_sum = vec3(0.0);
     float scale = float(gi.indirect_scale);
     // Position in reduced-resolution pixel units, relative to sample centres.
     vec2 at = (vec2(pixel) + 0.5) / scale - 0.5;
@@ -52,10 +55,12 @@ vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n, out vec4 visibility) {
             if (cones) {
                 visibility_sum += w * imageLoad(shadow, low);
             }
+            specular_sum += w * imageLoad(specular_low, low).rgb;
             weight += w;
         }
     }
     visibility = weight > 1e-6 ? visibility_sum / weight : vec4(1.0);
+    specular = weight > 1e-6 ? specular_sum / weight : vec3(0.0);
     return weight > 1e-6 ? sum / weight : vec4(0.0, 0.0, 0.0, 1.0);
 }
 
@@ -84,16 +89,16 @@ void main() {
     vec3 start = p + n * (2.0 * gi.origin.w);
 
     vec4 cone_visibility_low;
-    vec4 gathered = upsampled_indirect(pixel, p, n, cone_visibility_low);
+    vec3 reflected;
+    vec4 gathered = upsampled_indirect(pixel, p, n, cone_visibility_low, reflected);
     float ao = enabled(FLAG_AO) ? gathered.a : 1.0;
     vec3 indirect_light = vec3(0.0);
     if (enabled(FLAG_INDIRECT_DIFFUSE)) {
         indirect_light += albedo_specular.rgb * gathered.rgb;
     }
     float specular = albedo_specular.a;
-    if (specular > 0.0 && enabled(FLAG_INDIRECT_SPECULAR)) {
-        // The cone's half-angle follows the roughness: tan(half) ~ roughness.
-        indirect_light += specular * trace_cone(start, reflect(-v, n), roughness, 0.0, -1).rgb;
+    if (enabled(FLAG_INDIRECT_SPECULAR)) {
+        indirect_light += specular * reflected;
     }
     indirect_light *= ao;
 
