@@ -76,6 +76,11 @@ gpu_layout! {
         BINDING_GI_SHADOW = 14;
         /// GI passes (set 2): specular cone radiance (rgb) at reduced resolution, `rgba16f` storage.
         BINDING_GI_SPECULAR = 15;
+        /// GI passes (set 2): the occupied voxels, `VoxelList` storage buffer (also the
+        /// indirect dispatch arguments of the passes that run over them).
+        BINDING_GI_VOXEL_LIST = 16;
+        /// Workgroup size of the passes that run over the voxel list.
+        VOXEL_LIST_GROUP_SIZE = 64;
         /// Lights whose soft-shadow cones are traced at the reduced resolution of the
         /// indirect light (one channel each); further lights trace theirs per pixel.
         CONE_SHADOW_LIGHTS = 4;
@@ -245,6 +250,18 @@ gpu_layout! {
         uint pad0,
         /// Unused.
         uint pad1,
+    }
+
+    /// Head of the occupied-voxel list; the voxels follow as `uint` (x | y << 10 | z << 20).
+    struct VoxelListHeader {
+        /// Indirect dispatch: workgroups of `VOXEL_LIST_GROUP_SIZE` covering `count`.
+        uint groups_x,
+        /// Indirect dispatch: 1.
+        uint groups_y,
+        /// Indirect dispatch: 1.
+        uint groups_z,
+        /// Voxels in the list.
+        uint count,
     }
 
     /// Push constants of every mesh draw.

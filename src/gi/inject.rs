@@ -45,16 +45,16 @@ impl InjectPass {
             .dispatch(cmd, &sets, groups_3d(n, layout::VOXEL_GROUP_SIZE));
     }
 
-    /// One more bounce: direct + albedo x gathered filtered radiance, into the radiance.
+    /// One more bounce: direct + albedo x gathered filtered radiance, into the radiance,
+    /// for every voxel of the occupied-voxel list (`list`, which holds the dispatch).
     pub fn record_bounce(
         &self,
         cmd: vk::CommandBuffer,
         frame_set: vk::DescriptorSet,
         gi_set: vk::DescriptorSet,
-        n: u32,
+        list: vk::Buffer,
     ) {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
-        self.bounce
-            .dispatch(cmd, &sets, groups_3d(n, layout::VOXEL_GROUP_SIZE));
+        self.bounce.dispatch_indirect(cmd, &sets, list);
     }
 }

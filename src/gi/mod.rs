@@ -4,6 +4,7 @@
 //! Per frame: voxelize (clear + rasterize into packed RGBA8 averages) -> inject (voxel
 //! shading) -> filter (anisotropic mips) -> cone trace (after the direct lighting).
 
+mod compact;
 mod cone_trace;
 mod debug;
 mod filter;
@@ -301,6 +302,11 @@ fn gi_bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_GI_GBUFFER_TRANSMISSION, storage, all),
         Binding::new(layout::BINDING_GI_SHADOW, storage, all),
         Binding::new(layout::BINDING_GI_SPECULAR, storage, all),
+        Binding::new(
+            layout::BINDING_GI_VOXEL_LIST,
+            vk::DescriptorType::STORAGE_BUFFER,
+            all,
+        ),
     ]
 }
 
@@ -341,6 +347,7 @@ pub struct DenseGi {
     filter: filter::FilterPass,
     cone_trace: cone_trace::ConeTracePass,
     voxel_view: debug::VoxelViewPass,
+    compact: compact::CompactPass,
     set: vk::DescriptorSet,
     _sets: DescriptorSets,
     uniforms: Buffer,
@@ -443,6 +450,18 @@ impl DenseGi {
             Ok(())
         })?;
         let gi_layout = sets.layout;
+        let compact = compact::CompactPass::new(
+            ctx,
+            [set_layouts[0], set_layouts[1], gi_layout],
+            resolution,
+        )?;
+        SetWriter::new(ctx, set)
+            .buffer(
+                layout::BINDING_GI_VOXEL_LIST,
+                vk::DescriptorType::STORAGE_BUFFER,
+                compact.list.raw,
+            )
+            .apply();
         Ok(Self {
             grid,
             voxelize: voxelize::VoxelizePass::new(
@@ -467,6 +486,7 @@ impl DenseGi {
                 ctx,
                 [set_layouts[0], set_layouts[1], gi_layout],
             )?,
+            compact,
             volumes,
             set,
             _sets: sets,
@@ -550,9 +570,11 @@ impl DenseGi {
         self.history = false;
     }
 
-    /// GPU memory of every voxel volume, by name.
+    /// GPU memory of every voxel volume and the voxel list, by name.
     pub fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
-        self.volumes.bytes()
+        let mut bytes = self.volumes.bytes();
+        bytes.push(("voxel_list", self.compact.list.size));
+        bytes
     }
 
     /// Voxelizes the scene and lights and filters the voxels (after the shadow maps).
@@ -568,6 +590,8 @@ impl DenseGi {
     ) {
         let ctx = &self.ctx;
         let n = self.grid.resolution;
+        let voxelized =
+            self.full_update || !self.static_ready || self.volumes.static_packed.is_some();
         if self.full_update || !self.static_ready {
             timer.begin(cmd, "voxelize");
             for image in self.volumes.packed() {
@@ -600,6 +624,23 @@ impl DenseGi {
                 .record(ctx, cmd, draw, self.set, n, voxelize::Meshes::Moving);
             timer.end(cmd);
         }
+        if voxelized {
+            timer.begin(cmd, "compact");
+            memory_barrier(
+                ctx,
+                cmd,
+                (
+                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_READ,
+                ),
+            );
+            self.compact.record(ctx, cmd, draw.frame_set, self.set, n);
+            timer.end(cmd);
+        }
 
         timer.begin(cmd, "inject");
         memory_barrier(
@@ -630,7 +671,8 @@ impl DenseGi {
         for _ in 0..bounces {
             timer.begin(cmd, "bounce");
             compute_to_compute(ctx, cmd);
-            self.inject.record_bounce(cmd, draw.frame_set, self.set, n);
+            self.inject
+                .record_bounce(cmd, draw.frame_set, self.set, self.compact.list.raw);
             compute_to_compute(ctx, cmd);
             self.filter.record(ctx, cmd, n);
             timer.end(cmd);
@@ -781,6 +823,56 @@ impl DenseGi {
         self.cone_trace
             .record_upsample(cmd, frame_set, self.set, extent);
         timer.end(cmd);
+    }
+
+    /// Downloads the occupied-voxel list (x, y, z of each entry, in list order) once the
+    /// frames that build it are done.
+    #[cfg(test)]
+    pub fn download_voxel_list(&self) -> Result<Vec<[u32; 3]>> {
+        let ctx = &self.ctx;
+        let list = &self.compact.list;
+        let buffer = Buffer::new(
+            ctx,
+            "voxel list readback",
+            list.size,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            gpu_allocator::MemoryLocation::GpuToCpu,
+        )?;
+        OneShot::new(ctx)?.run("download voxel list", |cmd| {
+            memory_barrier(
+                ctx,
+                cmd,
+                (
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_READ,
+                ),
+            );
+            let region = vk::BufferCopy::default().size(list.size);
+            unsafe {
+                ctx.device
+                    .cmd_copy_buffer(cmd, list.raw, buffer.raw, &[region])
+            };
+            copies_to_host_barrier(ctx, cmd);
+            Ok(())
+        })?;
+        let words: &[u32] = bytemuck::cast_slice(buffer.mapped());
+        let header: layout::VoxelListHeader =
+            bytemuck::pod_read_unaligned(bytemuck::cast_slice(&words[..4]));
+        let expected_groups = header.count.div_ceil(layout::VOXEL_LIST_GROUP_SIZE);
+        anyhow::ensure!(
+            (header.groups_x, header.groups_y, header.groups_z) == (expected_groups, 1, 1),
+            "dispatch {:?} for {} voxels",
+            (header.groups_x, header.groups_y, header.groups_z),
+            header.count
+        );
+        Ok(words[4..4 + header.count as usize]
+            .iter()
+            .map(|v| [v & 0x3ff, (v >> 10) & 0x3ff, v >> 20])
+            .collect())
     }
 
     /// Downloads one level of a volume, texel after texel (x fastest), once the frames

@@ -116,6 +116,18 @@ impl Pipeline {
     }
 
     /// Binds one more descriptor set to the bound pipeline.
+    /// Binds the pipeline and `sets`, then dispatches the workgroup counts stored at the
+    /// start of `args`.
+    pub fn dispatch_indirect(
+        &self,
+        cmd: vk::CommandBuffer,
+        sets: &[(u32, vk::DescriptorSet)],
+        args: vk::Buffer,
+    ) {
+        self.bind(cmd, sets);
+        unsafe { self.ctx.device.cmd_dispatch_indirect(cmd, args, 0) };
+    }
+
     pub fn bind_set(&self, cmd: vk::CommandBuffer, index: u32, set: vk::DescriptorSet) {
         unsafe {
             self.ctx.device.cmd_bind_descriptor_sets(

@@ -1,29 +1,33 @@
 #version 460
-// One more bounce of light between voxels (Villegas 2018 §4): each occupied voxel gathers
-// the filtered radiance over the hemisphere of its lit face (injection turned the normal
-// to it) and adds albedo times it to its direct radiance.
+// One more bounce of light between voxels (Villegas 2018 §4), over the list of occupied
+// voxels (compact.comp): each gathers the filtered radiance over the hemisphere of its
+// lit face (injection turned the normal to it) and adds albedo times it to its direct
+// radiance.
 // Cones read only the directional levels (lod >= 1), never the base level rewritten here.
 #include "gi/cones.glsl"
 
-layout(local_size_x = VOXEL_GROUP_SIZE, local_size_y = VOXEL_GROUP_SIZE, local_size_z = VOXEL_GROUP_SIZE) in;
+layout(local_size_x = VOXEL_LIST_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform readonly uimage3D voxel_albedo;
 layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform readonly uimage3D voxel_normal;
 layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform readonly image3D voxel_direct;
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance_out;
+layout(set = SET_PASS, binding = BINDING_GI_VOXEL_LIST, std430) readonly buffer VoxelListBlock {
+    VoxelListHeader list;
+    uint list_voxels[];
+};
 
 // Cones per voxel gather, whatever --diffuse-cones asks of the screen: six cover the
 // hemisphere well enough for light that is filtered again before anyone sees it.
 const int BOUNCE_CONES = 6;
 
 void main() {
-    ivec3 voxel = ivec3(gl_GlobalInvocationID);
-    if (any(greaterThanEqual(voxel, ivec3(gi.resolution)))) {
+    uint index = gl_GlobalInvocationID.x;
+    if (index >= list.count) {
         return;
     }
+    uint packed_voxel = list_voxels[index];
+    ivec3 voxel = ivec3(packed_voxel & 0x3ffu, (packed_voxel >> 10) & 0x3ffu, packed_voxel >> 20);
     vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, voxel).r);
-    if (albedo.a == 0.0) {
-        return;
-    }
     vec3 n = unpack_rgba8(imageLoad(voxel_normal, voxel).r).xyz / 255.0 * 2.0 - 1.0;
     n = length(n) > 0.2 ? normalize(n) : vec3(0.0, 1.0, 0.0);
     vec3 p = voxel_center(voxel);

@@ -1,0 +1,109 @@
+//! The occupied-voxel list (`glsl/gi/compact/compact.comp`): the voxel bounces run over
+//! it, one invocation per occupied voxel, dispatched indirectly from its head.
+
+use std::sync::Arc;
+
+use anyhow::Result;
+use ash::vk;
+
+use crate::gpu_layout::{self as layout, VoxelListHeader};
+use crate::vk::{groups_3d, memory_barrier, Buffer, Context, Pipeline};
+
+pub struct CompactPass {
+    pipeline: Pipeline,
+    /// `VoxelListHeader` then one `u32` per voxel of the grid (all may be occupied).
+    pub list: Buffer,
+}
+
+impl CompactPass {
+    /// `set_layouts` are those of sets 0, 1 and 2; `n` is the grid resolution.
+    pub fn new(
+        ctx: &Arc<Context>,
+        set_layouts: [vk::DescriptorSetLayout; 3],
+        n: u32,
+    ) -> Result<Self> {
+        let pipeline = Pipeline::compute(
+            ctx,
+            "compact",
+            crate::vk::shaders::GI_COMPACT_COMPACT_COMP,
+            &set_layouts,
+            0,
+        )?;
+        let header = std::mem::size_of::<VoxelListHeader>() as u64;
+        let list = Buffer::new(
+            ctx,
+            "voxel list",
+            header + 4 * u64::from(n).pow(3),
+            // TRANSFER_SRC: the check against the occupancy downloads it.
+            vk::BufferUsageFlags::STORAGE_BUFFER
+                | vk::BufferUsageFlags::INDIRECT_BUFFER
+                | vk::BufferUsageFlags::TRANSFER_DST
+                | vk::BufferUsageFlags::TRANSFER_SRC,
+            gpu_allocator::MemoryLocation::GpuOnly,
+        )?;
+        Ok(Self { pipeline, list })
+    }
+
+    /// Rebuilds the list from the voxel albedo (after voxelization). Waits for last
+    /// frame's bounces, which read the list.
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        frame_set: vk::DescriptorSet,
+        gi_set: vk::DescriptorSet,
+        n: u32,
+    ) {
+        let readers =
+            vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT;
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                readers,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+            ),
+            (
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            ),
+        );
+        let empty = VoxelListHeader {
+            groups_x: 0,
+            groups_y: 1,
+            groups_z: 1,
+            count: 0,
+        };
+        unsafe {
+            ctx.device
+                .cmd_update_buffer(cmd, self.list.raw, 0, bytemuck::bytes_of(&empty))
+        };
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            ),
+        );
+        let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
+        self.pipeline
+            .dispatch(cmd, &sets, groups_3d(n, layout::VOXEL_GROUP_SIZE));
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            ),
+            (
+                readers,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+            ),
+        );
+    }
+}
