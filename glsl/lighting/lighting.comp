@@ -21,21 +21,22 @@ void main() {
         imageStore(radiance_out, pixel, vec4(sky, 1.0));
         return;
     }
-    vec4 albedo = imageLoad(gbuffer_albedo, pixel);
-    vec4 normal_roughness = imageLoad(gbuffer_normal, pixel);
-    vec3 p = pixel_position(pixel, depth);
-    vec3 n = normalize(normal_roughness.xyz);
-    vec3 v = normalize(frame.camera_position.xyz - p);
     vec3 radiance = (frame.flags & FLAG_EMISSION) != 0u ? imageLoad(gbuffer_emission, pixel).rgb : vec3(0.0);
     // With soft-shadow cones the GI gather adds the direct light, shadowed through the voxels.
-    bool direct = (frame.flags & (FLAG_DIRECT | FLAG_SHADOW_CONES)) == FLAG_DIRECT;
-    for (uint i = 0u; direct && i < frame.light_count; i++) {
-        vec3 l;
-        vec3 e = light_irradiance(lights[i], p, n, l);
-        if (all(equal(e, vec3(0.0)))) {
-            continue;
+    if ((frame.flags & (FLAG_DIRECT | FLAG_SHADOW_CONES)) == FLAG_DIRECT) {
+        vec4 albedo = imageLoad(gbuffer_albedo, pixel);
+        vec4 normal_roughness = imageLoad(gbuffer_normal, pixel);
+        vec3 p = pixel_position(pixel, depth);
+        vec3 n = normalize(normal_roughness.xyz);
+        vec3 v = normalize(frame.camera_position.xyz - p);
+        for (uint i = 0u; i < frame.light_count; i++) {
+            vec3 l;
+            vec3 e = light_irradiance(lights[i], p, n, l);
+            if (all(equal(e, vec3(0.0)))) {
+                continue;
+            }
+            radiance += surface_brdf(albedo.rgb, albedo.a, normal_roughness.w, n, v, l) * e;
         }
-        radiance += surface_brdf(albedo.rgb, albedo.a, normal_roughness.w, n, v, l) * e;
     }
     imageStore(radiance_out, pixel, vec4(radiance, 1.0));
 }

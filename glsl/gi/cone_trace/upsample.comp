@@ -22,9 +22,10 @@ layout(set = SET_PASS, binding = BINDING_GI_SPECULAR, rgba16f) uniform readonly 
 layout(set = SET_PASS, binding = BINDING_GI_SCREEN, rgba32f) uniform image2D screen_radiance;
 
 // The gathered indirect light (rgb) and ambient occlusion (a) at `pixel`, upsampled;
-// also the specular cone's radiance and, with soft-shadow cones, the first lights'
-// visibility.
-vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n, out vec4 visibility, out vec3 specular) {
+// with `glossy` also the specular cone's radiance and, with soft-shadow cones, the first
+// lights' visibility (each image is read only where it is needed: on a CPU driver every
+// load counts).
+vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n, bool glossy, out vec4 visibility, out vec3 specular) {
     bool cones = (frame.flags & FLAG_SHADOW_CONES) != 0u;
     vec4 visibility_sum = vec4(0.0);
     vec3 specular_sum = vec3(0.0);
@@ -55,7 +56,9 @@ vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n, out vec4 visibility, out ve
             if (cones) {
                 visibility_sum += w * imageLoad(shadow, low);
             }
-            specular_sum += w * imageLoad(specular_low, low).rgb;
+            if (glossy) {
+                specular_sum += w * imageLoad(specular_low, low).rgb;
+            }
             weight += w;
         }
     }
@@ -87,17 +90,18 @@ void main() {
     vec4 albedo_specular = imageLoad(gbuffer_albedo, pixel);
     float roughness = clamp(normal_roughness.w, 0.02, 1.0);
     vec3 start = p + n * (2.0 * gi.origin.w);
+    float specular = albedo_specular.a;
+    bool glossy = specular > 0.0 && enabled(FLAG_INDIRECT_SPECULAR);
 
     vec4 cone_visibility_low;
     vec3 reflected;
-    vec4 gathered = upsampled_indirect(pixel, p, n, cone_visibility_low, reflected);
+    vec4 gathered = upsampled_indirect(pixel, p, n, glossy, cone_visibility_low, reflected);
     float ao = enabled(FLAG_AO) ? gathered.a : 1.0;
     vec3 indirect_light = vec3(0.0);
     if (enabled(FLAG_INDIRECT_DIFFUSE)) {
         indirect_light += albedo_specular.rgb * gathered.rgb;
     }
-    float specular = albedo_specular.a;
-    if (enabled(FLAG_INDIRECT_SPECULAR)) {
+    if (glossy) {
         indirect_light += specular * reflected;
     }
     indirect_light *= ao;
