@@ -42,46 +42,73 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
     return lod < 1.0 ? mix(base, aniso, lod) : aniso;
 }
 
-// Front-to-back accumulation along one cone; returns premultiplied radiance (rgb) and
-// occlusion (a), with the sky behind whatever the cone leaves open.
-vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod) {
+// Where a cone leaving the surface at `surface` with normal `n` samples at distance
+// `dist` from `origin` (texture coordinates), with the sample's footprint `lod` and cone
+// `diameter` there.
+// A cone 60 degrees off the normal with a 30 degree half-angle grazes the surface's own
+// plane, and the trilinear lookup blends cells up to one cell size from the sample
+// point: the surface would occlude and light itself (its lit voxels seen edge-on).
+// Each sample point is lifted along n to at least one cell size above the plane, so
+// that no cell centred on or below the plane enters the blend.
+vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lod, vec3 surface, vec3 n,
+                 out float lod, out float diameter) {
     float voxel = gi.origin.w;
-    float grid_size = voxel * float(gi.resolution);
+    diameter = max(voxel, 2.0 * tan_half * dist);
+    lod = max(log2(diameter / voxel), min_lod);
+    vec3 x = origin + dir * dist;
+    x += n * max(voxel * exp2(lod) - dot(x - surface, n), 0.0);
+    return (x - gi.origin.xyz) / (voxel * float(gi.resolution));
+}
+
+bool inside_grid(vec3 uvw) {
+    return all(greaterThanEqual(uvw, vec3(0.0))) && all(lessThanEqual(uvw, vec3(1.0)));
+}
+
+// Front-to-back accumulation along one cone leaving the surface at `surface` with normal
+// `n`; returns premultiplied radiance (rgb) and occlusion (a), with the sky behind
+// whatever the cone leaves open.
+vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surface, vec3 n) {
     vec4 acc = vec4(0.0);
-    float dist = voxel;
-    while (acc.a < 0.99 && dist < gi.max_distance) {
-        float diameter = max(voxel, 2.0 * tan_half * dist);
-        float lod = max(log2(diameter / voxel), min_lod);
-        vec3 uvw = (origin + dir * dist - gi.origin.xyz) / grid_size;
-        if (any(lessThan(uvw, vec3(0.0))) || any(greaterThan(uvw, vec3(1.0)))) {
-            break;
-        }
+    float dist = gi.origin.w;
+    float lod;
+    float diameter;
+    vec3 uvw = cone_sample(origin, dir, dist, tan_half, min_lod, surface, n, lod, diameter);
+    while (acc.a < 0.99 && dist < gi.max_distance && inside_grid(uvw)) {
         vec4 s = sample_voxels(uvw, dir, lod);
         float step_length = diameter * gi.step_factor;
-        // Opacity was filtered for a step of one sample diameter; correct it to this step.
-        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), step_length / diameter);
+        float next_lod;
+        float next_diameter;
+        vec3 next_uvw = cone_sample(origin, dir, dist + step_length, tan_half, min_lod, surface, n, next_lod, next_diameter);
+        // Opacity was filtered for a path of one sample diameter; correct it to the path
+        // from this sample to the next, longer than the step where the lift bends it.
+        float path = distance(next_uvw, uvw) * gi.origin.w * float(gi.resolution);
+        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), path / diameter);
         vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
         acc.rgb += (1.0 - acc.a) * rgb;
         acc.a += (1.0 - acc.a) * a;
         dist += step_length;
+        uvw = next_uvw;
+        lod = next_lod;
+        diameter = next_diameter;
     }
     acc.rgb += (1.0 - acc.a) * frame.sky_radiance.rgb;
     return acc;
 }
 
 
-// Cosine-weighted mean radiance over the hemisphere around n from `gi.diffuse_cones`
-// cones: one along n, the others in a ring 60 degrees from it.
-vec3 gather_diffuse(vec3 origin, vec3 n, float min_lod) {
+// Cosine-weighted mean radiance over the hemisphere around n of the surface at `surface`
+// from `gi.diffuse_cones` cones starting at `origin`: one along n, the others in a ring
+// 60 degrees from it.
+vec3 gather_diffuse(vec3 surface, vec3 origin, vec3 n, float min_lod) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);
-    vec3 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod).rgb;
+    vec3 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod, surface, n).rgb;
     float weight = 1.0;
     int ring = int(gi.diffuse_cones) - 1;
     for (int i = 0; i < ring; i++) {
         float phi = 6.2831853 * float(i) / float(ring);
         vec3 dir = normalize(0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b));
-        sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod).rgb * 0.5;
+        sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod, surface, n).rgb * 0.5;
         weight += 0.5;
     }
     return sum / weight;

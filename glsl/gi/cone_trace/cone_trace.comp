@@ -25,6 +25,6 @@ void main() {
     // Start two voxels off the surface so the cones do not gather their own voxels, and
     // sample no finer than 2-voxel cells (the base level adds nothing measurable here:
     // Cornell box LDR-FLIP 0.1801 either way).
-    vec3 gathered = gather_diffuse(p + n * (2.0 * gi.origin.w), n, 1.0);
+    vec3 gathered = gather_diffuse(p, p + n * (2.0 * gi.origin.w), n, 1.0);
     imageStore(indirect, low, vec4(gathered, 1.0));
 }

@@ -58,7 +58,7 @@ void main() {
         float roughness = clamp(imageLoad(gbuffer_normal, pixel).w, 0.02, 1.0);
         vec3 v = normalize(frame.camera_position.xyz - p);
         vec3 r = reflect(-v, n);
-        indirect_light += specular * trace_cone(p + n * (2.0 * gi.origin.w), r, roughness, 0.0).rgb;
+        indirect_light += specular * trace_cone(p + n * (2.0 * gi.origin.w), r, roughness, 0.0, p, n).rgb;
     }
     vec4 direct = imageLoad(screen_radiance, pixel);
     imageStore(screen_radiance, pixel, vec4(direct.rgb + indirect_light, direct.a));
