@@ -20,7 +20,11 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
 
 // Voxel radiance at `uvw` for a cone travelling along `dir` with footprint `lod` (0 = one
 // voxel): the base level below lod 1, blended into the three directional volumes facing
-// the cone, weighted by the squared direction components.
+// the cone, weighted by the squared direction components w. The optical depths add up,
+// weighted by w, so the transmittance is the product of the three raised to w: a wall
+// opaque along one axis stays opaque to any cone that crosses it, where a weighted mean
+// of the opacities would let a cone at 45 degrees see half through it (and light leave
+// the room). The colour is the opacity-weighted mean of the three.
 vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
     vec4 base = textureLod(voxel_radiance, uvw, 0.0);
     if (lod <= 0.0) {
@@ -28,48 +32,77 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
     }
     vec3 w = dir * dir;
     float level = max(lod - 1.0, 0.0);
-    vec4 aniso = w.x * sample_directional(dir.x >= 0.0 ? 0 : 1, uvw, level)
-        + w.y * sample_directional(dir.y >= 0.0 ? 2 : 3, uvw, level)
-        + w.z * sample_directional(dir.z >= 0.0 ? 4 : 5, uvw, level);
+    vec4 sx = sample_directional(dir.x >= 0.0 ? 0 : 1, uvw, level);
+    vec4 sy = sample_directional(dir.y >= 0.0 ? 2 : 3, uvw, level);
+    vec4 sz = sample_directional(dir.z >= 0.0 ? 4 : 5, uvw, level);
+    vec4 mean = w.x * sx + w.y * sy + w.z * sz;
+    vec3 transmittance = 1.0 - clamp(vec3(sx.a, sy.a, sz.a), 0.0, 0.9999);
+    float alpha = 1.0 - exp2(dot(w, log2(transmittance)));
+    vec4 aniso = mean.a > 1e-4 ? vec4(mean.rgb * (alpha / mean.a), alpha) : vec4(0.0);
     return lod < 1.0 ? mix(base, aniso, lod) : aniso;
 }
 
-// Front-to-back accumulation along one cone; returns premultiplied radiance (rgb) with
-// the sky behind whatever the cone leaves open, and (a) the occlusion that ambient
-// occlusion counts, each occluder weighted down with its distance d by
-// 1 / (1 + d / gi.ao_distance). Ambient occlusion reads opacity from the one
-// directional volume `ao_volume` (0..5, or -1: none) travelling away from the surface
-// along the axis closest to its normal: the surface's own voxels are hidden from it by
-// the filter's facing weight, whereas the three volumes a slanted cone blends see them
-// edge-on, so an open plane would occlude itself.
-vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, int ao_volume) {
+// Where a cone leaving the surface at `surface` with normal `n` samples at distance
+// `dist` from `origin` (texture coordinates), with the sample's footprint `lod` and cone
+// `diameter` there.
+// A cone 60 degrees off the normal with a 30 degree half-angle grazes the surface's own
+// plane, and the trilinear lookup blends cells up to one cell size from the sample
+// point: the surface would occlude and light itself (its lit voxels seen edge-on).
+// Each sample point is lifted along n to at least one cell size above the plane, so
+// that no cell centred on or below the plane enters the blend.
+vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lod, vec3 surface, vec3 n,
+                 out float lod, out float diameter) {
     float voxel = gi.origin.w;
-    float grid_size = voxel * float(gi.resolution);
+    diameter = max(voxel, 2.0 * tan_half * dist);
+    lod = max(log2(diameter / voxel), min_lod);
+    vec3 x = origin + dir * dist;
+    x += n * max(voxel * exp2(lod) - dot(x - surface, n), 0.0);
+    return (x - gi.origin.xyz) / (voxel * float(gi.resolution));
+}
+
+bool inside_grid(vec3 uvw) {
+    return all(greaterThanEqual(uvw, vec3(0.0))) && all(lessThanEqual(uvw, vec3(1.0)));
+}
+
+// Front-to-back accumulation along one cone leaving the surface at `surface` with normal
+// `n`; returns premultiplied radiance (rgb) with the sky behind whatever the cone leaves
+// open, and (a) the occlusion that ambient occlusion counts, each occluder weighted down
+// with its distance d by 1 / (1 + d / gi.ao_distance). Ambient occlusion reads opacity
+// from the one directional volume `ao_volume` (0..5, or -1: none) travelling away from
+// the surface along the axis closest to its normal: the surface's own voxels are hidden
+// from it by the filter's facing weight, whereas the three volumes a slanted cone blends
+// see them edge-on, so an open plane would occlude itself.
+vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surface, vec3 n, int ao_volume) {
     vec4 acc = vec4(0.0);
     float ao = 0.0;
     float ao_alpha = 0.0;
-    float dist = voxel;
-    while (acc.a < 0.99 && dist < gi.max_distance) {
-        float diameter = max(voxel, 2.0 * tan_half * dist);
-        float lod = max(log2(diameter / voxel), min_lod);
-        vec3 uvw = (origin + dir * dist - gi.origin.xyz) / grid_size;
-        if (any(lessThan(uvw, vec3(0.0))) || any(greaterThan(uvw, vec3(1.0)))) {
-            break;
-        }
+    float dist = gi.origin.w;
+    float lod;
+    float diameter;
+    vec3 uvw = cone_sample(origin, dir, dist, tan_half, min_lod, surface, n, lod, diameter);
+    while (acc.a < 0.99 && dist < gi.max_distance && inside_grid(uvw)) {
         vec4 s = sample_voxels(uvw, dir, lod);
         float step_length = diameter * gi.step_factor;
-        // Opacity was filtered for a step of one sample diameter; correct it to this step.
-        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), step_length / diameter);
+        float next_lod;
+        float next_diameter;
+        vec3 next_uvw = cone_sample(origin, dir, dist + step_length, tan_half, min_lod, surface, n, next_lod, next_diameter);
+        // Opacity was filtered for a path of one sample diameter; correct it to the path
+        // from this sample to the next, longer than the step where the lift bends it.
+        float path = distance(next_uvw, uvw) * gi.origin.w * float(gi.resolution);
+        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), path / diameter);
         vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
         acc.rgb += (1.0 - acc.a) * rgb;
         acc.a += (1.0 - acc.a) * a;
         if (ao_volume >= 0) {
             float o = sample_directional(ao_volume, uvw, max(lod - 1.0, 0.0)).a;
-            o = 1.0 - pow(1.0 - clamp(o, 0.0, 0.9999), gi.step_factor);
+            o = 1.0 - pow(1.0 - clamp(o, 0.0, 0.9999), path / diameter);
             ao += (1.0 - ao_alpha) * o / (1.0 + dist / gi.ao_distance);
             ao_alpha += (1.0 - ao_alpha) * o;
         }
         dist += step_length;
+        uvw = next_uvw;
+        lod = next_lod;
+        diameter = next_diameter;
     }
     acc.rgb += (1.0 - acc.a) * frame.sky_radiance.rgb;
     return vec4(acc.rgb, ao);
@@ -85,7 +118,7 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
     while (occlusion < 0.99 && dist < max_dist) {
         float diameter = max(voxel, 2.0 * tan_half * dist);
         vec3 uvw = (origin + dir * dist - gi.origin.xyz) / grid_size;
-        if (any(lessThan(uvw, vec3(0.0))) || any(greaterThan(uvw, vec3(1.0)))) {
+        if (!inside_grid(uvw)) {
             break;
         }
         float s = sample_voxels(uvw, dir, log2(diameter / voxel)).a;
@@ -96,10 +129,11 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
     return 1.0 - occlusion;
 }
 
-// Cosine-weighted mean radiance over the hemisphere around n from `cones` cones from
-// `origin`: one along n, the others in a ring 60 degrees from it. With `with_ao`, alpha
-// is the ambient occlusion (1 where nothing near occludes); else 1.
-vec4 gather_diffuse(vec3 origin, vec3 n, int cones, float min_lod, bool with_ao) {
+// Cosine-weighted mean radiance over the hemisphere around n of the surface at `surface`
+// from `cones` cones starting at `origin`: one along n, the others in a ring 60 degrees
+// from it. With `with_ao`, alpha is the ambient occlusion (1 where nothing near
+// occludes); else 1.
+vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod, bool with_ao) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);
     int ao_volume = -1;
@@ -108,13 +142,13 @@ vec4 gather_diffuse(vec3 origin, vec3 n, int cones, float min_lod, bool with_ao)
         int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
         ao_volume = 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
     }
-    vec4 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod, ao_volume);
+    vec4 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod, surface, n, ao_volume);
     float weight = 1.0;
     int ring = cones - 1;
     for (int i = 0; i < ring; i++) {
         float phi = 6.2831853 * float(i) / float(ring);
         vec3 dir = normalize(0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b));
-        sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod, ao_volume) * 0.5;
+        sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod, surface, n, ao_volume) * 0.5;
         weight += 0.5;
     }
     sum /= weight;

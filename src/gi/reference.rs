@@ -92,14 +92,14 @@ fn mark(triangles: &[[Vec3; 3]], grid: &Grid, grow: f32) -> Vec<bool> {
 /// Premultiplied RGBA `front` composited over `back`: what a ray sees passing through
 /// `front` first, then `back`.
 /// The weight `glsl/gi/filter/filter.comp` gives a base voxel with (lit-side) normal `n`
-/// for cones travelling along `direction`: 1 facing the cone or edge-on, 0 from behind.
+/// for cones travelling along `direction`: 1 facing the cone, 1/2 edge-on, 0 from behind.
 pub fn facing_weight(n: Vec3, direction: usize) -> f32 {
     if n.length() < 0.2 {
         return 1.0;
     }
     let mut towards_viewer = Vec3::ZERO;
     towards_viewer[direction / 2] = if direction % 2 == 0 { -1.0 } else { 1.0 };
-    (1.0 + 4.0 * n.normalize().dot(towards_viewer)).clamp(0.0, 1.0)
+    (0.5 + 4.0 * n.normalize().dot(towards_viewer)).clamp(0.0, 1.0)
 }
 
 pub fn over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {

@@ -34,7 +34,7 @@ void main() {
     // Ambient occlusion costs one more sample per step: only when shown or applied.
     bool with_ao = (frame.flags & FLAG_AO) != 0u || frame.debug_view == DEBUG_AO;
     vec3 start = p + n * (2.0 * gi.origin.w);
-    imageStore(indirect, low, gather_diffuse(start, n, int(gi.diffuse_cones), 1.0, with_ao));
+    imageStore(indirect, low, gather_diffuse(p, start, n, int(gi.diffuse_cones), 1.0, with_ao));
     // Soft shadows change at the scale of the voxels, like the indirect light: their
     // cones are traced here too, for the first lights.
     if ((frame.flags & FLAG_SHADOW_CONES) != 0u) {
@@ -53,7 +53,7 @@ void main() {
     if (imageLoad(gbuffer_albedo, pixel).a > 0.0 && (frame.flags & FLAG_INDIRECT_SPECULAR) != 0u) {
         vec3 v = normalize(frame.camera_position.xyz - p);
         float roughness = clamp(normal_roughness.w, 0.02, 1.0);
-        imageStore(specular, low, trace_cone(start, reflect(-v, n), roughness, 0.0, -1));
+        imageStore(specular, low, trace_cone(start, reflect(-v, n), roughness, 0.0, p, n, -1));
     } else {
         imageStore(specular, low, vec4(0.0));
     }

@@ -129,8 +129,9 @@ void main() {
         // n faces the camera: the ray enters the surface (relative index 1 / Ni).
         vec3 t = refract(-v, n, 1.0 / max(transmission.g, 1.0));
         vec3 dir = dot(t, t) > 0.0 ? t : reflect(-v, n);
-        float side = dot(dir, n) < 0.0 ? -1.0 : 1.0;
-        transmitted = transmission.r * trace_cone(p + side * n * (2.0 * gi.origin.w), dir, roughness, 0.0, -1).rgb;
+        // The cone leaves the surface on the side it points to.
+        vec3 side = dot(dir, n) < 0.0 ? -n : n;
+        transmitted = transmission.r * trace_cone(p + side * (2.0 * gi.origin.w), dir, roughness, 0.0, p, side, -1).rgb;
         surface = (1.0 - transmission.r) * surface + transmitted;
     }
 
