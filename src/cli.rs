@@ -91,7 +91,7 @@ pub struct CommonArgs {
     #[arg(long)]
     pub diffuse_cones: Option<u32>,
     /// Trace indirect light on one pixel of each NxN block and upsample, 1 to 8
-    /// [default: 2, or height / 180 on taller images: 4 at 720 rows].
+    /// [default: height / 128, at least 2: 5 at 720 rows].
     #[arg(long)]
     pub indirect_scale: Option<u32>,
     /// Recompute every bounce every frame, instead of adding one bounce per frame to the

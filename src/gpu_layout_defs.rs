@@ -81,6 +81,9 @@ gpu_layout! {
         BINDING_GI_VOXEL_LIST = 16;
         /// Workgroup size of the passes that run over the voxel list.
         VOXEL_LIST_GROUP_SIZE = 64;
+        /// GI passes (set 2): G-buffer emission, `rgba16f` storage (the upsample shades the
+        /// pixels itself with soft-shadow cones, and the lighting pass does not run).
+        BINDING_GI_GBUFFER_EMISSION = 17;
         /// Lights whose soft-shadow cones are traced at the reduced resolution of the
         /// indirect light (one channel each); further lights trace theirs per pixel.
         CONE_SHADOW_LIGHTS = 4;

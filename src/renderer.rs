@@ -474,7 +474,10 @@ impl Renderer {
             for (on, flag) in [
                 (t.indirect_diffuse, layout::FLAG_INDIRECT_DIFFUSE),
                 (t.indirect_specular, layout::FLAG_INDIRECT_SPECULAR),
-                (t.transmission, layout::FLAG_TRANSMISSION),
+                (
+                    t.transmission && self.scene.materials.iter().any(|m| m.dissolve < 1.0),
+                    layout::FLAG_TRANSMISSION,
+                ),
                 (t.ambient_occlusion, layout::FLAG_AO),
                 (gi.shadow_cones, layout::FLAG_SHADOW_CONES),
             ] {
@@ -614,15 +617,28 @@ impl Renderer {
             gi.record_update(cmd, timer, &draw);
         }
 
-        timer.begin(cmd, "lighting");
-        self.lighting.record(
-            &ctx,
-            cmd,
-            data.set,
-            &self.targets.radiance,
-            self.radiance_last_use,
-        );
-        timer.end(cmd);
+        // With soft-shadow cones the GI's upsample pass shades every pixel.
+        if maps_needed {
+            timer.begin(cmd, "lighting");
+            self.lighting.record(
+                &ctx,
+                cmd,
+                data.set,
+                &self.targets.radiance,
+                self.radiance_last_use,
+            );
+            timer.end(cmd);
+        } else {
+            let radiance = &self.targets.radiance;
+            image_barrier(
+                &ctx,
+                cmd,
+                radiance.raw,
+                radiance.full_range(),
+                ImageUse::discard_after(self.radiance_last_use),
+                ImageUse::COMPUTE_WRITE,
+            );
+        }
         if let Some(gi) = self.gi.as_ref().filter(|_| self.indirect) {
             let voxel_view = self.settings.debug_view.shows_voxels();
             gi.record_gather(cmd, timer, data.set, extent, voxel_view);

@@ -131,12 +131,12 @@ impl ConeSettings {
 }
 
 /// The default reduction of the indirect light's resolution for an image `height` pixels
-/// high: 2, or one traced pixel per 180th of the height on taller images (4 at 720 rows,
-/// 6 at 1080). Indirect diffuse light varies at the scale of the voxels, not of the
-/// pixels; this keeps the traced samples per degree of view at least those of the
-/// 256x256 quality measurements (128 rows).
+/// high: height / 128 (at least 2), so that it is traced on 128 to 255 rows whatever the
+/// image size (2 at 256 rows, where the quality is measured against the references; 5 at
+/// 720). Indirect diffuse light and soft shadows vary at the scale of the voxels, not of
+/// the pixels.
 pub fn auto_indirect_scale(height: u32) -> u32 {
-    (height / 180).clamp(2, 8)
+    (height / 128).clamp(2, 8)
 }
 
 /// Voxels per axis unless the command line or the scene file says otherwise.
@@ -302,6 +302,7 @@ fn gi_bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_GI_GBUFFER_TRANSMISSION, storage, all),
         Binding::new(layout::BINDING_GI_SHADOW, storage, all),
         Binding::new(layout::BINDING_GI_SPECULAR, storage, all),
+        Binding::new(layout::BINDING_GI_GBUFFER_EMISSION, storage, all),
         Binding::new(
             layout::BINDING_GI_VOXEL_LIST,
             vk::DescriptorType::STORAGE_BUFFER,
@@ -554,6 +555,7 @@ impl DenseGi {
                 layout::BINDING_GI_GBUFFER_TRANSMISSION,
                 gbuffer.transmission.view,
             )
+            .storage_image(layout::BINDING_GI_GBUFFER_EMISSION, gbuffer.emission.view)
             .sampled_image(
                 layout::BINDING_GI_GBUFFER_DEPTH,
                 gbuffer.depth.view,

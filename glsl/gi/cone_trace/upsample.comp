@@ -5,8 +5,9 @@
 //   those whose surface lies at another depth or faces another way), times albedo;
 // - indirect specular: the cone along the reflection traced for glossy pixels (Ks > 0)
 //   at reduced resolution, upsampled like the diffuse light, times Ks;
-// - direct light shadowed by soft-shadow cones, when they replace the shadow maps (the
-//   first lights' visibility upsampled like the indirect light);
+// - with soft-shadow cones instead of shadow maps, the whole shading: emission and the
+//   direct light (the first lights' visibility upsampled like the indirect light), as the
+//   lighting pass does not run then;
 // - ambient occlusion on the indirect terms;
 // - transmission: transmissive pixels (d < 1) pass 1 - d of the light from one cone
 //   along the refracted ray.
@@ -20,6 +21,7 @@ layout(set = SET_PASS, binding = BINDING_GI_INDIRECT, rgba16f) uniform readonly 
 layout(set = SET_PASS, binding = BINDING_GI_SHADOW, rgba16f) uniform readonly image2D shadow;
 layout(set = SET_PASS, binding = BINDING_GI_SPECULAR, rgba16f) uniform readonly image2D specular_low;
 layout(set = SET_PASS, binding = BINDING_GI_SCREEN, rgba32f) uniform image2D screen_radiance;
+layout(set = SET_PASS, binding = BINDING_GI_GBUFFER_EMISSION, rgba16f) uniform readonly image2D gbuffer_emission;
 
 // The gathered indirect light (rgb) and ambient occlusion (a) at `pixel`, upsampled;
 // with `glossy` also the specular cone's radiance and, with soft-shadow cones, the first
@@ -76,10 +78,15 @@ void main() {
     if (pixel.x >= int(frame.width) || pixel.y >= int(frame.height)) {
         return;
     }
+    // With soft-shadow cones this pass shades the pixels from scratch (the lighting pass
+    // does not run); otherwise it adds to the lighting pass's direct light.
+    bool shades = enabled(FLAG_SHADOW_CONES);
     float depth = texelFetch(gbuffer_depth, pixel, 0).r;
     if (depth >= 1.0) {
         if (frame.debug_view != DEBUG_NONE) {
             imageStore(screen_radiance, pixel, vec4(frame.debug_view == DEBUG_AO ? vec3(1.0) : vec3(0.0), 1.0));
+        } else if (shades) {
+            imageStore(screen_radiance, pixel, vec4(enabled(FLAG_EMISSION) ? frame.sky_radiance.rgb : vec3(0.0), 1.0));
         }
         return;
     }
@@ -106,8 +113,13 @@ void main() {
     }
     indirect_light *= ao;
 
-    vec3 surface = imageLoad(screen_radiance, pixel).rgb;
-    if (enabled(FLAG_SHADOW_CONES) && enabled(FLAG_DIRECT)) {
+    vec3 surface;
+    if (!shades) {
+        surface = imageLoad(screen_radiance, pixel).rgb;
+    } else {
+        surface = enabled(FLAG_EMISSION) ? imageLoad(gbuffer_emission, pixel).rgb : vec3(0.0);
+    }
+    if (shades && enabled(FLAG_DIRECT)) {
         for (uint i = 0u; i < frame.light_count; i++) {
             vec3 l;
             float dist;
