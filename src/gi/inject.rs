@@ -6,7 +6,7 @@ use anyhow::Result;
 use ash::vk;
 
 use crate::gpu_layout as layout;
-use crate::vk::{groups_3d, Context, Pipeline};
+use crate::vk::{Context, Pipeline};
 
 pub struct InjectPass {
     pipeline: Pipeline,
@@ -33,16 +33,16 @@ impl InjectPass {
         Ok(Self { pipeline, bounce })
     }
 
+    /// Shades every voxel of the occupied-voxel list (`list`, which holds the dispatch).
     pub fn record(
         &self,
         cmd: vk::CommandBuffer,
         frame_set: vk::DescriptorSet,
         gi_set: vk::DescriptorSet,
-        n: u32,
+        list: vk::Buffer,
     ) {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
-        self.pipeline
-            .dispatch(cmd, &sets, groups_3d(n, layout::VOXEL_GROUP_SIZE));
+        self.pipeline.dispatch_indirect(cmd, &sets, list);
     }
 
     /// One more bounce: direct + albedo x gathered filtered radiance, into the radiance,

@@ -184,6 +184,14 @@ struct Volumes {
 }
 
 const PACKED_FORMAT: vk::Format = vk::Format::R32_UINT;
+/// The radiance volumes between passes: written as storage, sampled by cones.
+const RADIANCE_USE: ImageUse = ImageUse {
+    layout: vk::ImageLayout::GENERAL,
+    stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+    access: vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::SHADER_READ.as_raw() | vk::AccessFlags2::SHADER_WRITE.as_raw(),
+    ),
+};
 /// The packed volumes after injection: read, and the normals turned to their lit side.
 const PACKED_AFTER_INJECT: ImageUse = ImageUse {
     layout: vk::ImageLayout::GENERAL,
@@ -202,9 +210,11 @@ impl Volumes {
             | vk::ImageUsageFlags::TRANSFER_DST
             | vk::ImageUsageFlags::TRANSFER_SRC;
         let packed = |name| Image::new(ctx, name, ImageDesc::d3(PACKED_FORMAT, n, 1, packed_usage));
+        // TRANSFER_DST: cleared when the voxels change.
         let radiance_usage = vk::ImageUsageFlags::STORAGE
             | vk::ImageUsageFlags::SAMPLED
-            | vk::ImageUsageFlags::TRANSFER_SRC;
+            | vk::ImageUsageFlags::TRANSFER_SRC
+            | vk::ImageUsageFlags::TRANSFER_DST;
         let mut directional_desc =
             ImageDesc::d3(RADIANCE_FORMAT, n / 2, n.trailing_zeros(), radiance_usage);
         directional_desc.extent.width = 6 * (n / 2);
@@ -641,6 +651,36 @@ impl DenseGi {
                 ),
             );
             self.compact.record(ctx, cmd, draw.frame_set, self.set, n);
+            // Injection writes only the listed voxels: the others must read zero.
+            for image in [&self.volumes.radiance, &self.volumes.direct] {
+                let range = image.full_range();
+                image_barrier(
+                    ctx,
+                    cmd,
+                    image.raw,
+                    range,
+                    ImageUse::discard_after(RADIANCE_USE),
+                    ImageUse::TRANSFER_DST,
+                );
+                let zero = vk::ClearColorValue { float32: [0.0; 4] };
+                unsafe {
+                    ctx.device.cmd_clear_color_image(
+                        cmd,
+                        image.raw,
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                        &zero,
+                        &[range],
+                    )
+                };
+                image_barrier(
+                    ctx,
+                    cmd,
+                    image.raw,
+                    range,
+                    ImageUse::TRANSFER_DST,
+                    RADIANCE_USE,
+                );
+            }
             timer.end(cmd);
         }
 
@@ -659,7 +699,8 @@ impl DenseGi {
         );
         // Last frame's cone tracing sampled the radiance volumes that are rewritten now.
         compute_to_compute(ctx, cmd);
-        self.inject.record(cmd, draw.frame_set, self.set, n);
+        self.inject
+            .record(cmd, draw.frame_set, self.set, self.compact.list.raw);
         timer.end(cmd);
 
         let bounces = if self.history { 1 } else { self.bounces - 1 };

@@ -5,28 +5,24 @@
 // radiance.
 // Cones read only the directional levels (lod >= 1), never the base level rewritten here.
 #include "gi/cones.glsl"
+#include "gi/voxel_list.glsl"
 
 layout(local_size_x = VOXEL_LIST_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform readonly uimage3D voxel_albedo;
 layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform readonly uimage3D voxel_normal;
 layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform readonly image3D voxel_direct;
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance_out;
-layout(set = SET_PASS, binding = BINDING_GI_VOXEL_LIST, std430) readonly buffer VoxelListBlock {
-    VoxelListHeader list;
-    uint list_voxels[];
-};
+
 
 // Cones per voxel gather, whatever --diffuse-cones asks of the screen: six cover the
 // hemisphere well enough for light that is filtered again before anyone sees it.
 const int BOUNCE_CONES = 6;
 
 void main() {
-    uint index = gl_GlobalInvocationID.x;
-    if (index >= list.count) {
+    ivec3 voxel;
+    if (!listed_voxel(voxel)) {
         return;
     }
-    uint packed_voxel = list_voxels[index];
-    ivec3 voxel = ivec3(packed_voxel & 0x3ffu, (packed_voxel >> 10) & 0x3ffu, packed_voxel >> 20);
     vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, voxel).r);
     vec3 n = unpack_rgba8(imageLoad(voxel_normal, voxel).r).xyz / 255.0 * 2.0 - 1.0;
     n = length(n) > 0.2 ? normalize(n) : vec3(0.0, 1.0, 0.0);

@@ -1,5 +1,6 @@
 #version 460
-// Deferred voxel shading (Villegas 2018): per occupied voxel, outgoing radiance =
+// Deferred voxel shading (Villegas 2018), over the list of occupied voxels (the others
+// were cleared to zero): per occupied voxel, outgoing radiance =
 // albedo / pi * direct irradiance (the surface shading's units) + emission, stored
 // premultiplied by opacity. Visibility comes from the shadow maps (one bilinear compare:
 // a voxel is wider than the PCF kernel), or with soft-shadow cones, which make the
@@ -7,8 +8,9 @@
 #include "common/frame.glsl"
 #include "common/direct_light.glsl"
 #include "gi/voxels.glsl"
+#include "gi/voxel_list.glsl"
 
-layout(local_size_x = VOXEL_GROUP_SIZE, local_size_y = VOXEL_GROUP_SIZE, local_size_z = VOXEL_GROUP_SIZE) in;
+layout(local_size_x = VOXEL_LIST_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform readonly uimage3D voxel_albedo;
 layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform uimage3D voxel_normal;
 layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform readonly uimage3D voxel_emission;
@@ -46,16 +48,11 @@ vec3 voxel_irradiance(GpuLight light, vec3 p, vec3 n) {
 }
 
 void main() {
-    ivec3 voxel = ivec3(gl_GlobalInvocationID);
-    if (any(greaterThanEqual(voxel, ivec3(gi.resolution)))) {
+    ivec3 voxel;
+    if (!listed_voxel(voxel)) {
         return;
     }
     vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, voxel).r);
-    if (albedo.a == 0.0) {
-        imageStore(voxel_radiance, voxel, vec4(0.0));
-        imageStore(voxel_direct, voxel, vec4(0.0));
-        return;
-    }
     vec3 rho = albedo.rgb / 255.0;
     vec4 packed_normal = unpack_rgba8(imageLoad(voxel_normal, voxel).r);
     vec3 n = packed_normal.xyz / 255.0 * 2.0 - 1.0;
