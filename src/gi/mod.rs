@@ -26,8 +26,9 @@ use crate::gpu_layout::{self as layout, GiUniforms};
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
-    copies_to_host_barrier, image_barrier, memory_barrier, sampler_info, Binding, Buffer, Context,
-    DescriptorSets, GpuTimer, Image, ImageDesc, ImageUse, OneShot, Sampler, SetWriter,
+    clear_to_zero, copies_to_host_barrier, image_barrier, memory_barrier, sampler_info, Binding,
+    Buffer, Context, DescriptorSets, GpuTimer, Image, ImageDesc, ImageUse, OneShot, Sampler,
+    SetWriter,
 };
 
 /// The cube the voxels tile: voxel (i, j, k) covers origin + [i, i+1) x [j, j+1) x [k, k+1)
@@ -607,7 +608,14 @@ impl DenseGi {
         if self.full_update || !self.static_ready {
             timer.begin(cmd, "voxelize");
             for image in self.volumes.packed() {
-                self.clear_packed(cmd, image);
+                // Last frame's injection read these.
+                clear_to_zero(
+                    ctx,
+                    cmd,
+                    image,
+                    PACKED_AFTER_INJECT,
+                    voxelize::VoxelizePass::IMAGE_USE,
+                );
             }
             if self.full_update {
                 self.voxelize
@@ -653,33 +661,7 @@ impl DenseGi {
             self.compact.record(ctx, cmd, draw.frame_set, self.set, n);
             // Injection writes only the listed voxels: the others must read zero.
             for image in [&self.volumes.radiance, &self.volumes.direct] {
-                let range = image.full_range();
-                image_barrier(
-                    ctx,
-                    cmd,
-                    image.raw,
-                    range,
-                    ImageUse::discard_after(RADIANCE_USE),
-                    ImageUse::TRANSFER_DST,
-                );
-                let zero = vk::ClearColorValue { float32: [0.0; 4] };
-                unsafe {
-                    ctx.device.cmd_clear_color_image(
-                        cmd,
-                        image.raw,
-                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                        &zero,
-                        &[range],
-                    )
-                };
-                image_barrier(
-                    ctx,
-                    cmd,
-                    image.raw,
-                    range,
-                    ImageUse::TRANSFER_DST,
-                    RADIANCE_USE,
-                );
+                clear_to_zero(ctx, cmd, image, RADIANCE_USE, RADIANCE_USE);
             }
             timer.end(cmd);
         }
@@ -720,37 +702,6 @@ impl DenseGi {
             self.filter.record(ctx, cmd, n);
             timer.end(cmd);
         }
-    }
-
-    /// Zeroes a packed volume for voxelization (last frame's injection read it).
-    fn clear_packed(&self, cmd: vk::CommandBuffer, image: &Image) {
-        let ctx = &self.ctx;
-        image_barrier(
-            ctx,
-            cmd,
-            image.raw,
-            image.full_range(),
-            ImageUse::discard_after(PACKED_AFTER_INJECT),
-            ImageUse::TRANSFER_DST,
-        );
-        let zero = vk::ClearColorValue { uint32: [0; 4] };
-        unsafe {
-            ctx.device.cmd_clear_color_image(
-                cmd,
-                image.raw,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &zero,
-                &[image.full_range()],
-            )
-        };
-        image_barrier(
-            ctx,
-            cmd,
-            image.raw,
-            image.full_range(),
-            ImageUse::TRANSFER_DST,
-            voxelize::VoxelizePass::IMAGE_USE,
-        );
     }
 
     /// Copies packed volume `from` to `to`. `from_working` says which one is the working

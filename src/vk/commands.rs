@@ -5,7 +5,7 @@ use std::sync::Arc;
 use anyhow::{Context as _, Result};
 use ash::vk;
 
-use super::Context;
+use super::{Context, Image};
 
 /// One side of an image barrier: a layout with the stages and accesses that use it.
 #[derive(Clone, Copy, Debug)]
@@ -132,6 +132,37 @@ pub fn memory_barrier(
         .dst_access_mask(dst.1)];
     let dependency = vk::DependencyInfo::default().memory_barriers(&barrier);
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
+}
+
+/// Clears every level and layer of a colour image to zero (all bits: any format), which
+/// was in state `before` and is left in state `after`; its contents are discarded.
+pub fn clear_to_zero(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    image: &Image,
+    before: ImageUse,
+    after: ImageUse,
+) {
+    let range = image.full_range();
+    image_barrier(
+        ctx,
+        cmd,
+        image.raw,
+        range,
+        ImageUse::discard_after(before),
+        ImageUse::TRANSFER_DST,
+    );
+    let zero = vk::ClearColorValue { uint32: [0; 4] };
+    unsafe {
+        ctx.device.cmd_clear_color_image(
+            cmd,
+            image.raw,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            &zero,
+            &[range],
+        )
+    };
+    image_barrier(ctx, cmd, image.raw, range, ImageUse::TRANSFER_DST, after);
 }
 
 /// Makes the copies recorded before it visible to host reads of their buffers (after the

@@ -10,7 +10,9 @@ mod swapchain;
 mod sync;
 mod timestamps;
 
-pub use commands::{copies_to_host_barrier, image_barrier, memory_barrier, ImageUse, OneShot};
+pub use commands::{
+    clear_to_zero, copies_to_host_barrier, image_barrier, memory_barrier, ImageUse, OneShot,
+};
 pub use context::{Context, ContextOptions, Features};
 pub use descriptors::{Binding, DescriptorSets, SetWriter};
 pub use memory::{
