@@ -18,27 +18,32 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
     return textureLod(voxel_directional, packed_uvw, level);
 }
 
-// Voxel radiance at `uvw` for a cone travelling along `dir` with footprint `lod` (0 = one
-// voxel): the base level below lod 1, blended into the three directional volumes facing
-// the cone, weighted by the squared direction components w. The optical depths add up,
-// weighted by w, so the transmittance is the product of the three raised to w: a wall
-// opaque along one axis stays opaque to any cone that crosses it, where a weighted mean
-// of the opacities would let a cone at 45 degrees see half through it (and light leave
-// the room). The colour is the opacity-weighted mean of the three.
-vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
-    vec4 base = textureLod(voxel_radiance, uvw, 0.0);
-    if (lod <= 0.0) {
-        return base;
-    }
+// Voxel radiance at `uvw` for a cone travelling along `dir`, from the three directional
+// volumes facing the cone at mip `level`, weighted by the squared direction components
+// w. The optical depths add up, weighted by w, so the transmittance is the product of
+// the three raised to w: a wall opaque along one axis stays opaque to any cone that
+// crosses it, where a weighted mean of the opacities would let a cone at 45 degrees see
+// half through it (and light leave the room). The colour is the opacity-weighted mean
+// of the three.
+vec4 sample_directional_volumes(vec3 uvw, vec3 dir, float level) {
     vec3 w = dir * dir;
-    float level = max(lod - 1.0, 0.0);
     vec4 sx = sample_directional(dir.x >= 0.0 ? 0 : 1, uvw, level);
     vec4 sy = sample_directional(dir.y >= 0.0 ? 2 : 3, uvw, level);
     vec4 sz = sample_directional(dir.z >= 0.0 ? 4 : 5, uvw, level);
     vec4 mean = w.x * sx + w.y * sy + w.z * sz;
     vec3 transmittance = 1.0 - clamp(vec3(sx.a, sy.a, sz.a), 0.0, 0.9999);
     float alpha = 1.0 - exp2(dot(w, log2(transmittance)));
-    vec4 aniso = mean.a > 1e-4 ? vec4(mean.rgb * (alpha / mean.a), alpha) : vec4(0.0);
+    return mean.a > 1e-4 ? vec4(mean.rgb * (alpha / mean.a), alpha) : vec4(0.0);
+}
+
+// Voxel radiance at `uvw` for a cone travelling along `dir` with footprint `lod` (0 = one
+// voxel): the base level below lod 1, blended into the directional volumes above.
+vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
+    vec4 base = textureLod(voxel_radiance, uvw, 0.0);
+    if (lod <= 0.0) {
+        return base;
+    }
+    vec4 aniso = sample_directional_volumes(uvw, dir, max(lod - 1.0, 0.0));
     return lod < 1.0 ? mix(base, aniso, lod) : aniso;
 }
 
@@ -81,7 +86,15 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surfa
     float diameter;
     vec3 uvw = cone_sample(origin, dir, dist, tan_half, min_lod, surface, n, lod, diameter);
     while (acc.a < 0.99 && dist < gi.max_distance && inside_grid(uvw)) {
-        vec4 s = sample_voxels(uvw, dir, lod);
+        // Cones that never sample below lod 1 (the diffuse ones) skip the base level: the
+        // branch is on a constant once inlined, where testing lod per sample cost more
+        // than the fetch it saves.
+        vec4 s;
+        if (min_lod >= 1.0) {
+            s = sample_directional_volumes(uvw, dir, lod - 1.0);
+        } else {
+            s = sample_voxels(uvw, dir, lod);
+        }
         float step_length = diameter * gi.step_factor;
         float next_lod;
         float next_diameter;
