@@ -169,7 +169,7 @@ impl GBufferPass {
             .depth_attachment(&depth);
         unsafe { ctx.device.cmd_begin_rendering(cmd, &rendering) };
         set_viewport(ctx, cmd, extent);
-        draw.draw_meshes(ctx, cmd, &self.pipeline, 0, None);
+        draw.draw_meshes(ctx, cmd, &self.pipeline, 0, None, |_| true);
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         for image in target.colors() {
             image_barrier(

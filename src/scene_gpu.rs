@@ -23,22 +23,10 @@ pub struct SceneDraw<'a> {
 }
 
 impl SceneDraw<'_> {
-    /// Binds `pipeline` and the geometry, then draws every mesh with its model matrix
-    /// and material in the push constants; `shadow_view` selects the shadow view.
-    /// `pass_set` is bound as set 2 when given.
+    /// Binds `pipeline` and the geometry, then draws every mesh that `keep` accepts with
+    /// its model matrix and material in the push constants; `shadow_view` selects the
+    /// shadow view. `pass_set` is bound as set 2 when given.
     pub fn draw_meshes(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        pipeline: &Pipeline,
-        shadow_view: u32,
-        pass_set: Option<vk::DescriptorSet>,
-    ) {
-        self.draw_meshes_where(ctx, cmd, pipeline, shadow_view, pass_set, |_| true);
-    }
-
-    /// [`Self::draw_meshes`] for the meshes `keep` accepts.
-    pub fn draw_meshes_where(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,

@@ -222,7 +222,7 @@ impl ShadowPass {
             // Slope-scaled bias removes acne on surfaces at grazing angles to the light;
             // the lighting pass adds a normal offset for the rest.
             unsafe { ctx.device.cmd_set_depth_bias(cmd, 0.0, 0.0, 1.5) };
-            draw.draw_meshes(ctx, cmd, &self.pipeline, index as u32, None);
+            draw.draw_meshes(ctx, cmd, &self.pipeline, index as u32, None, |_| true);
             unsafe { ctx.device.cmd_end_rendering(cmd) };
         }
         image_barrier(

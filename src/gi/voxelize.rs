@@ -77,7 +77,7 @@ impl VoxelizePass {
             Meshes::Static => mesh.animation.is_none(),
             Meshes::Moving => mesh.animation.is_some(),
         };
-        draw.draw_meshes_where(ctx, cmd, &self.pipeline, 0, Some(gi_set), keep);
+        draw.draw_meshes(ctx, cmd, &self.pipeline, 0, Some(gi_set), keep);
         unsafe { ctx.device.cmd_end_rendering(cmd) };
     }
 }
