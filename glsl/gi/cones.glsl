@@ -163,16 +163,24 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
         int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
         ao_volume = 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
     }
-    vec4 sum = trace_cone(origin, n, gi.diffuse_tan_half, min_lod, surface, n, ao_volume);
-    float weight = 1.0;
+    vec4 centre = trace_cone(origin, n, gi.diffuse_tan_half, min_lod, surface, n, ao_volume);
     int ring = cones - 1;
+    if (ring == 0) {
+        return vec4(centre.rgb, 1.0 - centre.a);
+    }
+    vec4 around = vec4(0.0);
     for (int i = 0; i < ring; i++) {
         float phi = 6.2831853 * float(i) / float(ring);
         vec3 dir = normalize(0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b));
-        sum += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod, surface, n, ao_volume) * 0.5;
-        weight += 0.5;
+        around += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod, surface, n, ao_volume);
     }
-    sum /= weight;
+    // Cosine weights: a cone of half-angle 30 degrees at angle a from n holds
+    // pi sin^2(30) cos(a) of the cosine-weighted hemisphere: pi/4 along n, pi/8 at 60
+    // degrees. Five such cones fill the ring at 60 degrees; more overlap and share the
+    // ring's pi * 5/8, so its share does not grow with the count (the gaps towards the
+    // horizon are filled in proportion).
+    float ring_share = 0.5 * float(min(ring, 5));
+    vec4 sum = (centre + ring_share * around / float(ring)) / (1.0 + ring_share);
     return vec4(sum.rgb, 1.0 - sum.a);
 }
 #endif
