@@ -50,9 +50,9 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset, int 
     return sum / (taps * taps);
 }
 
-// Irradiance at p (normal n) from one light, unshadowed, the unit vector towards it and
-// the distance to it (infinite for a directional light).
-vec3 light_incident(GpuLight light, vec3 p, vec3 n, out vec3 to_light, out float dist) {
+// Irradiance at p on a surface facing the light, the unit vector towards it and the
+// distance to it (infinite for a directional light).
+vec3 light_arriving(GpuLight light, vec3 p, out vec3 to_light, out float dist) {
     vec3 e;
     if (light.kind == LIGHT_DIRECTIONAL) {
         to_light = -light.direction.xyz;
@@ -69,7 +69,13 @@ vec3 light_incident(GpuLight light, vec3 p, vec3 n, out vec3 to_light, out float
             e *= smoothstep(light.direction.w, light.cos_inner, cos_axis);
         }
     }
-    return e * max(dot(n, to_light), 0.0);
+    return e;
+}
+
+// Irradiance at p (normal n) from one light, unshadowed, the unit vector towards it and
+// the distance to it (infinite for a directional light).
+vec3 light_incident(GpuLight light, vec3 p, vec3 n, out vec3 to_light, out float dist) {
+    return light_arriving(light, p, to_light, dist) * max(dot(n, to_light), 0.0);
 }
 
 // Irradiance at a surface point p (normal n) from one light, shadowed (5x5 PCF), and the

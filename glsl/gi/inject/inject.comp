@@ -35,11 +35,22 @@ float voxel_visibility(vec3 p, vec3 n, vec3 to_light, float dist) {
     return 1.0;
 }
 
-// Irradiance at the voxel p on its face with normal n from one light, shadowed.
+// Villegas' normal-weighted attenuation (2018, section 2.1): a voxel's averaged normal n
+// may point where none of its surfaces does (a floor meeting a wall averages to 45
+// degrees and would catch the light of both). Each axis face on n's side takes the
+// light at its own cosine, weighted by n's squared component on that axis.
+float voxel_attenuation(vec3 n, vec3 l) {
+    vec3 w = n * n;
+    vec3 d = max(sign(n) * l, vec3(0.0));
+    return dot(w, d);
+}
+
+// Irradiance at the voxel p on its side with (averaged) normal n from one light,
+// shadowed.
 vec3 voxel_irradiance(GpuLight light, vec3 p, vec3 n) {
     vec3 l;
     float dist;
-    vec3 e = light_incident(light, p, n, l, dist);
+    vec3 e = light_arriving(light, p, l, dist) * voxel_attenuation(n, l);
     if (all(equal(e, vec3(0.0)))) {
         return e;
     }
