@@ -297,15 +297,11 @@ impl Viewer {
     fn switch(&mut self, code: KeyCode) -> Option<String> {
         let renderer = &mut self.renderer;
         if code == KeyCode::KeyG {
+            if renderer.dense_gi().is_none() {
+                return Some("no indirect light: start with --gi dense to have it".into());
+            }
             let on = renderer.toggle_indirect();
-            return Some(format!(
-                "indirect light {}",
-                if on {
-                    "on"
-                } else {
-                    "off (start with --gi dense to have it)"
-                }
-            ));
+            return Some(format!("indirect light {}", if on { "on" } else { "off" }));
         }
         let settings = &mut renderer.settings;
         let gi = settings.gi.as_mut()?;
