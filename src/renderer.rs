@@ -401,6 +401,12 @@ impl Renderer {
         self.targets.gbuffer.extent()
     }
 
+    /// Whether this frame shadows the direct light with soft-shadow cones (GI on, and
+    /// asked for) instead of shadow maps.
+    fn shadow_cones_active(&self) -> bool {
+        self.indirect && self.gi.is_some() && self.settings.gi.is_some_and(|g| g.shadow_cones)
+    }
+
     /// Turns the indirect light on or off (when the renderer has GI); returns whether it
     /// is on now.
     pub fn toggle_indirect(&mut self) -> bool {
@@ -469,8 +475,8 @@ impl Renderer {
                 flags |= flag;
             }
         }
-        let gi = s.gi.filter(|_| self.indirect);
-        if let Some(gi) = gi {
+        let gi_on = self.indirect && s.gi.is_some();
+        if gi_on {
             for (on, flag) in [
                 (t.indirect_diffuse, layout::FLAG_INDIRECT_DIFFUSE),
                 (t.indirect_specular, layout::FLAG_INDIRECT_SPECULAR),
@@ -479,14 +485,14 @@ impl Renderer {
                     layout::FLAG_TRANSMISSION,
                 ),
                 (t.ambient_occlusion, layout::FLAG_AO),
-                (gi.shadow_cones, layout::FLAG_SHADOW_CONES),
+                (self.shadow_cones_active(), layout::FLAG_SHADOW_CONES),
             ] {
                 if on {
                     flags |= flag;
                 }
             }
         }
-        let debug_view = if gi.is_some() {
+        let debug_view = if gi_on {
             s.debug_view.code()
         } else {
             layout::DEBUG_NONE
@@ -570,6 +576,7 @@ impl Renderer {
         let views: Vec<ShadowView> =
             shadow::scene_views(&self.scene, time_s, self.settings.shadow_resolution);
         let extent = self.extent();
+        let shadow_cones = self.shadow_cones_active();
         let data = &mut self.frames[frame.slot];
         data.uniforms.write(0, bytemuck::bytes_of(&uniforms));
         data.lights.write(0, bytemuck::cast_slice(&lights));
@@ -595,12 +602,8 @@ impl Renderer {
         // Soft-shadow cones need no shadow maps (the voxels are lit by a voxel ray-march
         // then); they are rendered once all the same, so that they are valid when the
         // viewer switches back.
-        let maps_needed = !self
-            .settings
-            .gi
-            .is_some_and(|g| g.shadow_cones && self.indirect);
         let stale = !(self.settings.cache_shadows && self.shadow_inputs.as_ref() == Some(&inputs));
-        if self.shadow_inputs.is_none() || (maps_needed && stale) {
+        if self.shadow_inputs.is_none() || (!shadow_cones && stale) {
             timer.begin(cmd, "shadow");
             self.shadow.record(&ctx, cmd, &draw, &views);
             timer.end(cmd);
@@ -618,7 +621,7 @@ impl Renderer {
         }
 
         // With soft-shadow cones the GI's upsample pass shades every pixel.
-        if maps_needed {
+        if !shadow_cones {
             timer.begin(cmd, "lighting");
             self.lighting.record(
                 &ctx,

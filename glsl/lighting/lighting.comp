@@ -22,8 +22,8 @@ void main() {
         return;
     }
     vec3 radiance = (frame.flags & FLAG_EMISSION) != 0u ? imageLoad(gbuffer_emission, pixel).rgb : vec3(0.0);
-    // With soft-shadow cones the GI gather adds the direct light, shadowed through the voxels.
-    if ((frame.flags & (FLAG_DIRECT | FLAG_SHADOW_CONES)) == FLAG_DIRECT) {
+    // (With soft-shadow cones this pass does not run: the GI's upsample shades.)
+    if ((frame.flags & FLAG_DIRECT) != 0u) {
         vec4 albedo = imageLoad(gbuffer_albedo, pixel);
         vec4 normal_roughness = imageLoad(gbuffer_normal, pixel);
         vec3 p = pixel_position(pixel, depth);
