@@ -6,8 +6,9 @@ use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::gi::{check_voxels, ConeSettings, DEFAULT_VOXELS};
-use crate::renderer::{DebugView, GiSettings, RenderSettings, Terms, Tonemap};
+use crate::renderer::{DebugView, GiSettings, RenderSettings, SvoSettings, Terms, Tonemap};
 use crate::scene::{GiOverrides, LoadOptions};
+use crate::svo::check_depth;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -40,6 +41,9 @@ pub enum GiMode {
     /// Voxel cone tracing on a dense voxel grid in 3D textures.
     #[default]
     Dense,
+    /// The sparse voxel octree. Work in progress: `bench` builds it and reports its
+    /// statistics; its cone tracing is not written yet, so `render` and `view` refuse it.
+    Svo,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -80,6 +84,10 @@ pub struct CommonArgs {
     /// or the scene file's [gi] voxels].
     #[arg(long)]
     pub voxels: Option<u32>,
+    /// Levels of the sparse voxel octree (--gi svo), 6 to 10: an effective grid of
+    /// 2^depth voxels per axis [default: log2 of --voxels, so the dense default's 64³].
+    #[arg(long)]
+    pub octree_depth: Option<u32>,
     /// Full aperture of each diffuse cone, degrees, 1 to 179 [default: 60].
     #[arg(long)]
     pub diffuse_aperture: Option<f32>,
@@ -283,6 +291,11 @@ impl CommonArgs {
         };
         let voxels = self.voxels.or(scene.voxels).unwrap_or(DEFAULT_VOXELS);
         let shadow_cones = self.shadow_cones || scene.shadow_cones.unwrap_or(false);
+        let octree_depth = self.octree_depth.unwrap_or(voxels.trailing_zeros());
+        if self.octree_depth.is_some() && self.gi != GiMode::Svo {
+            bail!("--octree-depth sets the sparse voxel octree: it needs --gi svo");
+        }
+        let mut svo = None;
         let gi = match self.gi {
             GiMode::Dense => {
                 cones.check()?;
@@ -294,7 +307,7 @@ impl CommonArgs {
                     full_update: self.full_update,
                 })
             }
-            GiMode::Off => {
+            GiMode::Off | GiMode::Svo => {
                 let needs_gi = [
                     (self.shadow_cones, "--shadow-cones"),
                     (self.full_update, "--full-update"),
@@ -302,6 +315,13 @@ impl CommonArgs {
                 ];
                 if let Some((_, option)) = needs_gi.iter().find(|(set, _)| *set) {
                     bail!("{option} works on the voxels: it needs --gi dense");
+                }
+                if self.gi == GiMode::Svo {
+                    check_depth(octree_depth)?;
+                    svo = Some(SvoSettings {
+                        depth: octree_depth,
+                        capacities: None,
+                    });
                 }
                 None
             }
@@ -324,6 +344,7 @@ impl CommonArgs {
             debug_view: self.debug_view,
             debug_level: self.debug_level,
             gi,
+            svo,
         })
     }
 

@@ -98,6 +98,49 @@ gpu_layout! {
         /// Workgroup edge of the 3D compute passes.
         VOXEL_GROUP_SIZE = 4;
 
+        /// SVO passes (set 2; `BINDING_GI_UNIFORMS` holds the `GiUniforms` of the
+        /// effective grid): `SvoCounters` then `SvoLevel[SVO_MAX_LEVELS]`, storage buffer.
+        BINDING_SVO_COUNTERS = 1;
+        /// SVO passes (set 2): the voxel-fragment list, `VoxelFragment[]` storage buffer.
+        BINDING_SVO_FRAGMENTS = 2;
+        /// SVO passes (set 2): per node, its first child (children come in tiles of 8;
+        /// 0 = none) with `SVO_SUBDIVIDE` set while flagged, `uint[]` storage buffer.
+        BINDING_SVO_NODES = 3;
+        /// SVO passes (set 2): per node, its coordinates among its level's nodes
+        /// (x | y << 10 | z << 20), `uint[]` storage buffer.
+        BINDING_SVO_NODE_COORDS = 4;
+        /// SVO passes (set 2): per node, its brick (`SVO_NO_BRICK` for an empty node),
+        /// in the leaf pool for leaves, in the interior pool otherwise, `uint[]` storage buffer.
+        BINDING_SVO_NODE_BRICKS = 5;
+        /// SVO passes (set 2): per node, its six neighbours at its level (+X -X +Y -Y +Z
+        /// -Z; `SVO_NO_NODE` where none), `uint[]` storage buffer.
+        BINDING_SVO_NEIGHBOURS = 6;
+        /// SVO passes (set 2): leaf-brick albedo (2x2x2 voxels per brick), RGBA8 moving
+        /// average packed in `r32ui`, storage image.
+        BINDING_SVO_BRICK_ALBEDO = 7;
+        /// SVO passes (set 2): leaf-brick normal (xyz * 0.5 + 0.5), RGBA8 in `r32ui`.
+        BINDING_SVO_BRICK_NORMAL = 8;
+        /// SVO passes (set 2): leaf-brick emission / `GiUniforms.emission_range`, RGBA8 in `r32ui`.
+        BINDING_SVO_BRICK_EMISSION = 9;
+        /// Octree levels the level table has room for (depth 10 uses 10).
+        SVO_MAX_LEVELS = 16;
+        /// Workgroup size of the passes over fragments and over a level's nodes.
+        SVO_GROUP_SIZE = 64;
+        /// Bit of a node's child entry: the node is to be subdivided (or, for a leaf, holds voxels).
+        SVO_SUBDIVIDE = 0x80000000;
+        /// A missing node (neighbour pointers, look-ups).
+        SVO_NO_NODE = 0xFFFFFFFF;
+        /// A node without a brick (it holds no voxel).
+        SVO_NO_BRICK = 0xFFFFFFFF;
+        /// `SvoCounters.overflow` bit: the voxel-fragment list was too small.
+        SVO_OVERFLOW_FRAGMENTS = 1;
+        /// `SvoCounters.overflow` bit: the node pool was too small.
+        SVO_OVERFLOW_NODES = 2;
+        /// `SvoCounters.overflow` bit: the leaf brick pool was too small.
+        SVO_OVERFLOW_LEAF_BRICKS = 4;
+        /// `SvoCounters.overflow` bit: the interior brick pool was too small.
+        SVO_OVERFLOW_INTERIOR_BRICKS = 8;
+
         /// `GpuLight.kind`: point light, intensity in W/sr.
         LIGHT_POINT = 0;
         /// `GpuLight.kind`: spot light, intensity in W/sr on its axis.
@@ -265,6 +308,86 @@ gpu_layout! {
         uint groups_z,
         /// Voxels in the list.
         uint count,
+    }
+
+    /// The counters of the sparse voxel octree's pools; the level table follows.
+    struct SvoCounters {
+        /// Indirect dispatch over the stored fragments: workgroups of `SVO_GROUP_SIZE`.
+        uint fragment_groups_x,
+        /// Indirect dispatch: 1.
+        uint fragment_groups_y,
+        /// Indirect dispatch: 1.
+        uint fragment_groups_z,
+        /// Fragments produced (more than `fragment_capacity` when the list overflowed).
+        uint fragment_count,
+        /// Records the fragment list holds.
+        uint fragment_capacity,
+        /// Nodes allocated (more than `node_capacity` after an overflow).
+        uint node_count,
+        /// Nodes the node pool holds.
+        uint node_capacity,
+        /// `SVO_OVERFLOW_*` bits.
+        uint overflow,
+        /// Leaf bricks allocated.
+        uint leaf_bricks,
+        /// Leaf bricks the leaf pool holds.
+        uint leaf_brick_capacity,
+        /// Interior bricks allocated.
+        uint interior_bricks,
+        /// Interior bricks the interior pool holds.
+        uint interior_brick_capacity,
+        /// Bricks per edge of the leaf pool image: brick i sits at (i % side, i / side % side, i / side²).
+        uint leaf_pool_side,
+        /// Bricks per row and per column of the interior pool image.
+        uint interior_pool_side,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+    }
+
+    /// One level of the octree: its nodes are contiguous in the node pool.
+    struct SvoLevel {
+        /// Indirect dispatch over the level's nodes: workgroups of `SVO_GROUP_SIZE`.
+        uint groups_x,
+        /// Indirect dispatch: 1.
+        uint groups_y,
+        /// Indirect dispatch: 1.
+        uint groups_z,
+        /// Index of the level's first node.
+        uint first,
+        /// Nodes in the level.
+        uint count,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+        /// Unused.
+        uint pad2,
+    }
+
+    /// One voxel fragment: a triangle's sample of one voxel of the effective grid.
+    struct VoxelFragment {
+        /// Voxel coordinates x | y << 10 | z << 20.
+        uint position,
+        /// RGBA8 albedo (a = 255).
+        uint albedo,
+        /// RGBA8 normal, xyz * 0.5 + 0.5.
+        uint normal,
+        /// RGBA8 emission / `GiUniforms.emission_range`.
+        uint emission,
+    }
+
+    /// Push constants of the octree passes that work on one level.
+    struct SvoPush {
+        /// The level.
+        uint level,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+        /// Unused.
+        uint pad2,
     }
 
     /// Push constants of every mesh draw.

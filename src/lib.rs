@@ -16,4 +16,5 @@ pub mod renderer;
 pub mod scene;
 pub mod scene_gpu;
 pub mod shadow;
+pub mod svo;
 pub mod vk;

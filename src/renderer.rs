@@ -17,6 +17,7 @@ use crate::lighting::LightingPass;
 use crate::scene::{Camera, LightKind, Scene};
 use crate::scene_gpu::{GpuScene, SceneDraw};
 use crate::shadow::{self, ShadowPass};
+use crate::svo::{Capacities, SvoGi};
 use crate::vk::{
     copies_to_host_barrier, image_barrier, sampler_info, Binding, Buffer, Context, DescriptorSets,
     Frame, FrameRing, GpuTimer, Image, ImageUse, Sampler, SetWriter,
@@ -43,6 +44,15 @@ pub struct GiSettings {
     pub shadow_cones: bool,
     /// Re-voxelize and re-shade the static geometry every frame too (benchmarks).
     pub full_update: bool,
+}
+
+/// The sparse voxel octree.
+#[derive(Clone, Copy, Debug)]
+pub struct SvoSettings {
+    /// Levels of nodes: an effective grid of 2^depth voxels per axis.
+    pub depth: u32,
+    /// Pool sizes to start from instead of the estimate from the scene.
+    pub capacities: Option<Capacities>,
 }
 
 /// The terms of the final image; each can be switched.
@@ -138,6 +148,9 @@ pub struct RenderSettings {
     pub cache_shadows: bool,
     /// Indirect light; `None` for direct light only.
     pub gi: Option<GiSettings>,
+    /// Build the sparse voxel octree (`--gi svo`). Its cone tracing is not written yet,
+    /// so the frames themselves show direct light only.
+    pub svo: Option<SvoSettings>,
     pub terms: Terms,
     /// Needs `gi`.
     pub debug_view: DebugView,
@@ -155,6 +168,7 @@ impl Default for RenderSettings {
             shadow_resolution: 1024,
             cache_shadows: true,
             gi: None,
+            svo: None,
             terms: Terms::default(),
             debug_view: DebugView::None,
             debug_level: 0,
@@ -202,6 +216,7 @@ pub struct Renderer {
     gbuffer_pass: GBufferPass,
     shadow: ShadowPass,
     gi: Option<DenseGi>,
+    svo: Option<SvoGi>,
     /// Whether the GI passes run (the viewer's toggle).
     indirect: bool,
     /// Light views and mesh transforms the shadow maps were last rendered with.
@@ -360,6 +375,7 @@ impl Renderer {
             gbuffer_pass,
             shadow,
             gi,
+            svo: None,
             indirect: true,
             shadow_inputs: None,
             frames,
@@ -371,6 +387,18 @@ impl Renderer {
             ctx: ctx.clone(),
         };
         renderer.bind_targets()?;
+        if let Some(svo) = renderer.settings.svo {
+            let mut octree =
+                SvoGi::new(ctx, &renderer.scene, svo.depth, svo.capacities, set_layouts)?;
+            let draw = SceneDraw {
+                scene: &renderer.scene,
+                gpu: &renderer.gpu,
+                frame_set: renderer.frames[0].set,
+                time_s: 0.0,
+            };
+            octree.build(&draw)?;
+            renderer.svo = Some(octree);
+        }
         Ok(renderer)
     }
 
@@ -426,11 +454,19 @@ impl Renderer {
         self.gi.as_ref()
     }
 
-    /// GPU memory of the voxel volumes, by name (empty without GI).
+    /// The sparse voxel octree, when enabled.
+    pub fn svo(&self) -> Option<&SvoGi> {
+        self.svo.as_ref()
+    }
+
+    /// GPU memory of the voxel volumes or of the octree, by name (empty without GI).
     pub fn gi_memory_bytes(&self) -> Vec<(&'static str, u64)> {
-        self.gi
+        let mut bytes = self
+            .gi
             .as_ref()
-            .map_or_else(Vec::new, DenseGi::memory_bytes)
+            .map_or_else(Vec::new, DenseGi::memory_bytes);
+        bytes.extend(self.svo.iter().flat_map(SvoGi::memory_bytes));
+        bytes
     }
 
     /// Bytes of GPU memory held by scene textures.

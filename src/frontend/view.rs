@@ -120,6 +120,7 @@ impl Viewer {
         let swapchain = Swapchain::new(&ctx, surface, extent)?;
         let scene = load_scene(&args.common)?;
         let settings = args.common.render_settings(&scene.gi)?;
+        crate::frontend::refuse_svo(&settings)?;
         let bounds = scene.bounds(0.0);
         let scene_size = (bounds.max - bounds.min).length().max(1e-3);
         let renderer = Renderer::new(&ctx, scene, settings, swapchain.extent, swapchain.format)?;

@@ -42,7 +42,7 @@ impl InjectPass {
         list: vk::Buffer,
     ) {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
-        self.pipeline.dispatch_indirect(cmd, &sets, list);
+        self.pipeline.dispatch_indirect(cmd, &sets, list, 0);
     }
 
     /// One more bounce: direct + albedo x gathered filtered radiance, into the radiance,
@@ -55,6 +55,6 @@ impl InjectPass {
         list: vk::Buffer,
     ) {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
-        self.bounce.dispatch_indirect(cmd, &sets, list);
+        self.bounce.dispatch_indirect(cmd, &sets, list, 0);
     }
 }

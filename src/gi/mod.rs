@@ -10,10 +10,10 @@ mod debug;
 mod filter;
 mod inject;
 #[cfg(test)]
-pub mod reference;
+pub(crate) mod reference;
 #[cfg(test)]
 mod tests;
-mod voxelize;
+pub(crate) mod voxelize;
 
 use std::sync::Arc;
 
@@ -26,9 +26,8 @@ use crate::gpu_layout::{self as layout, GiUniforms};
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
-    clear_to_zero, copies_to_host_barrier, image_barrier, memory_barrier, sampler_info, Binding,
-    Buffer, Context, DescriptorSets, GpuTimer, Image, ImageDesc, ImageUse, OneShot, Sampler,
-    SetWriter,
+    clear_to_zero, image_barrier, memory_barrier, read_back_image, sampler_info, Binding, Buffer,
+    Context, DescriptorSets, GpuTimer, Image, ImageDesc, ImageUse, OneShot, Sampler, SetWriter,
 };
 
 /// The cube the voxels tile: voxel (i, j, k) covers origin + [i, i+1) x [j, j+1) x [k, k+1)
@@ -138,6 +137,16 @@ impl ConeSettings {
 /// the pixels.
 pub fn auto_indirect_scale(height: u32) -> u32 {
     (height / 128).clamp(2, 8)
+}
+
+/// The scene's largest emitted radiance: voxels store emission divided by it, in RGBA8.
+pub(crate) fn emission_range(scene: &Scene) -> f32 {
+    scene
+        .materials
+        .iter()
+        .map(|m| m.emission.max_element())
+        .fold(0.0f32, f32::max)
+        .max(1e-6)
 }
 
 /// Voxels per axis unless the command line or the scene file says otherwise.
@@ -324,7 +333,7 @@ fn gi_bindings() -> Vec<Binding> {
 
 /// A global barrier between two compute passes: writes before are visible to reads and
 /// writes after.
-fn compute_to_compute(ctx: &Context, cmd: vk::CommandBuffer) {
+pub(crate) fn compute_to_compute(ctx: &Context, cmd: vk::CommandBuffer) {
     let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
     memory_barrier(
         ctx,
@@ -388,12 +397,7 @@ impl DenseGi {
         let grid = Grid::around(scene, resolution);
         let moving_meshes = scene.meshes.iter().any(|m| m.animation.is_some());
         let volumes = Volumes::new(ctx, resolution, moving_meshes && !full_update)?;
-        let emission_range = scene
-            .materials
-            .iter()
-            .map(|m| m.emission.max_element())
-            .fold(0.0f32, f32::max)
-            .max(1e-6);
+        let emission_range = emission_range(scene);
         let uniforms = GiUniforms {
             origin: grid.origin.extend(grid.voxel_size).to_array(),
             resolution,
@@ -478,6 +482,8 @@ impl DenseGi {
             grid,
             voxelize: voxelize::VoxelizePass::new(
                 ctx,
+                "voxelize",
+                crate::vk::shaders::GI_VOXELIZE_VOXELIZE_FRAG,
                 [set_layouts[0], set_layouts[1], gi_layout],
             )?,
             inject: inject::InjectPass::new(ctx, [set_layouts[0], set_layouts[1], gi_layout])?,
@@ -823,37 +829,8 @@ impl DenseGi {
     /// frames that build it are done.
     #[cfg(test)]
     pub fn download_voxel_list(&self) -> Result<Vec<[u32; 3]>> {
-        let ctx = &self.ctx;
-        let list = &self.compact.list;
-        let buffer = Buffer::new(
-            ctx,
-            "voxel list readback",
-            list.size,
-            vk::BufferUsageFlags::TRANSFER_DST,
-            gpu_allocator::MemoryLocation::GpuToCpu,
-        )?;
-        OneShot::new(ctx)?.run("download voxel list", |cmd| {
-            memory_barrier(
-                ctx,
-                cmd,
-                (
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                ),
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_READ,
-                ),
-            );
-            let region = vk::BufferCopy::default().size(list.size);
-            unsafe {
-                ctx.device
-                    .cmd_copy_buffer(cmd, list.raw, buffer.raw, &[region])
-            };
-            copies_to_host_barrier(ctx, cmd);
-            Ok(())
-        })?;
-        let words: &[u32] = bytemuck::cast_slice(buffer.mapped());
+        let bytes = crate::vk::read_back_buffer(&self.ctx, &self.compact.list)?;
+        let words: &[u32] = bytemuck::cast_slice(&bytes);
         let header: layout::VoxelListHeader =
             bytemuck::pod_read_unaligned(bytemuck::cast_slice(&words[..4]));
         let expected_groups = header.count.div_ceil(layout::VOXEL_LIST_GROUP_SIZE);
@@ -888,73 +865,17 @@ impl DenseGi {
         } else {
             8
         };
-        let buffer = Buffer::new(
-            &self.ctx,
-            "volume readback",
-            u64::from(width) * u64::from(n).pow(2) * texel,
-            vk::BufferUsageFlags::TRANSFER_DST,
-            gpu_allocator::MemoryLocation::GpuToCpu,
-        )?;
-        let range = vk::ImageSubresourceRange {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            base_mip_level: level,
-            level_count: 1,
-            base_array_layer: 0,
-            layer_count: 1,
-        };
         let any_shader = ImageUse {
             layout: vk::ImageLayout::GENERAL,
             stage: vk::PipelineStageFlags2::ALL_COMMANDS,
             access: vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE,
         };
-        let ctx = &self.ctx;
-        OneShot::new(ctx)?.run("download volume", |cmd| {
-            image_barrier(
-                ctx,
-                cmd,
-                image.raw,
-                range,
-                any_shader,
-                ImageUse::TRANSFER_SRC,
-            );
-            let region = vk::BufferImageCopy {
-                buffer_offset: 0,
-                buffer_row_length: 0,
-                buffer_image_height: 0,
-                image_subresource: vk::ImageSubresourceLayers {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    mip_level: level,
-                    base_array_layer: 0,
-                    layer_count: 1,
-                },
-                image_offset: vk::Offset3D::default(),
-                image_extent: vk::Extent3D {
-                    width,
-                    height: n,
-                    depth: n,
-                },
-            };
-            unsafe {
-                ctx.device.cmd_copy_image_to_buffer(
-                    cmd,
-                    image.raw,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    buffer.raw,
-                    &[region],
-                )
-            };
-            image_barrier(
-                ctx,
-                cmd,
-                image.raw,
-                range,
-                ImageUse::TRANSFER_SRC,
-                any_shader,
-            );
-            copies_to_host_barrier(ctx, cmd);
-            Ok(())
-        })?;
-        let bytes = buffer.mapped();
+        let extent = vk::Extent3D {
+            width,
+            height: n,
+            depth: n,
+        };
+        let bytes = read_back_image(&self.ctx, image, level, extent, texel, any_shader)?;
         Ok(match volume {
             // Direction d's cube: the d-th run of n texels in every row.
             Volume::Directional(d) => {

@@ -155,6 +155,33 @@ pub fn filter_directional(level: &[[f32; 4]], n: u32, direction: usize) -> Vec<[
     out
 }
 
+/// Every triangle of `scene` at time 0, in world space.
+pub fn world_triangles(scene: &crate::scene::Scene) -> Vec<[Vec3; 3]> {
+    world_triangles_where(scene, |_| true)
+}
+
+/// The triangles of `scene` at time 0, in world space, whose material `keep` accepts.
+pub fn world_triangles_where(
+    scene: &crate::scene::Scene,
+    keep: impl Fn(&crate::scene::Material) -> bool,
+) -> Vec<[Vec3; 3]> {
+    let mut triangles = Vec::new();
+    for (m, mesh) in scene.meshes.iter().enumerate() {
+        if !keep(&scene.materials[mesh.material as usize]) {
+            continue;
+        }
+        let model = scene.mesh_transform(m, 0.0);
+        for t in mesh.indices.chunks_exact(3) {
+            triangles.push(
+                [t[0], t[1], t[2]].map(|i| {
+                    model.transform_point3(Vec3::from(mesh.vertices[i as usize].position))
+                }),
+            );
+        }
+    }
+    triangles
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -10,20 +10,9 @@ use super::reference;
 use super::{Grid, Volume};
 use crate::frontend::{Offscreen, LDR_FORMAT};
 use crate::renderer::{GiSettings, OutputTarget, RenderSettings, Renderer};
+use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
 use crate::vk::{Context, ContextOptions, ImageUse};
-
-fn shared_scene(path: &str) -> Option<std::path::PathBuf> {
-    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared")
-        .join(path);
-    if file.exists() {
-        Some(file)
-    } else {
-        eprintln!("skipped: {} is absent", file.display());
-        None
-    }
-}
 
 /// Renders 64x64 frames of `scene` with `--gi dense --voxels n`, one at each time,
 /// re-voxelizing the static meshes every frame with `full_update`.
@@ -79,21 +68,6 @@ fn render(scene: Scene, n: u32) -> (Arc<Context>, Renderer) {
     render_at(scene, n, &[0.0], false)
 }
 
-fn world_triangles(scene: &Scene) -> Vec<[Vec3; 3]> {
-    let mut triangles = Vec::new();
-    for (m, mesh) in scene.meshes.iter().enumerate() {
-        let model = scene.mesh_transform(m, 0.0);
-        for t in mesh.indices.chunks_exact(3) {
-            triangles.push(
-                [t[0], t[1], t[2]].map(|i| {
-                    model.transform_point3(Vec3::from(mesh.vertices[i as usize].position))
-                }),
-            );
-        }
-    }
-    triangles
-}
-
 fn occupancy(renderer: &Renderer) -> Vec<bool> {
     let bytes = renderer
         .dense_gi()
@@ -106,7 +80,7 @@ fn occupancy(renderer: &Renderer) -> Vec<bool> {
 /// Every voxel a triangle touches is occupied on the GPU, and the GPU's conservative
 /// rasterization adds none farther than one voxel from a triangle.
 fn check_voxelization(scene: Scene, n: u32) {
-    let triangles = world_triangles(&scene);
+    let triangles = reference::world_triangles(&scene);
     let (ctx, renderer) = render(scene, n);
     let grid: Grid = renderer.dense_gi().unwrap().grid;
     let gpu = occupancy(&renderer);
@@ -128,7 +102,7 @@ fn check_voxelization(scene: Scene, n: u32) {
 
 #[test]
 fn voxelization_matches_cpu_on_cornell_box() {
-    let Some(path) = shared_scene("scenes/cornell_box/CornellBox-Original.obj") else {
+    let Some(path) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
         return;
     };
     for n in [32, 64] {
@@ -173,14 +147,10 @@ fn halves(bytes: &[u8]) -> Vec<[f32; 4]> {
 /// voxel's lit face looks), within half-float rounding.
 #[test]
 fn filter_matches_cpu() {
-    let Some(path) = shared_scene("reference/cornell_point.scene.json") else {
+    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
         return;
     };
-    let options = LoadOptions {
-        diffuse_only: true,
-        no_normal_maps: true,
-        no_refraction: true,
-    };
+    let options = LoadOptions::REFERENCE;
     let n = 32;
     let (ctx, renderer) = render(Scene::load(&path, &options).unwrap(), n);
     let gi = renderer.dense_gi().unwrap();
@@ -227,7 +197,7 @@ fn filter_matches_cpu() {
 /// every frame.
 #[test]
 fn moving_mesh_leaves_no_voxels_behind() {
-    let Some(cornell) = shared_scene("scenes/cornell_box/CornellBox-Original.obj") else {
+    let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
         return;
     };
     let dir = std::env::temp_dir().join(format!("voxcone-moving-{}", std::process::id()));
@@ -280,7 +250,7 @@ fn moving_mesh_leaves_no_voxels_behind() {
 /// no voxelization), unless every frame is a full update.
 #[test]
 fn static_voxels_are_voxelized_once() {
-    let Some(path) = shared_scene("reference/cornell_point.scene.json") else {
+    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
         return;
     };
     let scene = Scene::load(&path, &LoadOptions::default()).unwrap();
@@ -305,7 +275,7 @@ fn static_voxels_are_voxelized_once() {
 /// storage-buffer hazards, so the buffer passes are checked by their result).
 #[test]
 fn voxel_list_holds_exactly_the_occupied_voxels() {
-    let Some(path) = shared_scene("reference/cornell_point.scene.json") else {
+    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
         return;
     };
     let scene = Scene::load(&path, &LoadOptions::default()).unwrap();

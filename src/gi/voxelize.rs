@@ -26,15 +26,22 @@ impl VoxelizePass {
         ),
     };
 
-    /// `set_layouts` are those of sets 0, 1 and 2.
-    pub fn new(ctx: &Arc<Context>, set_layouts: [vk::DescriptorSetLayout; 3]) -> Result<Self> {
+    /// `fragment` is the SPIR-V of the fragment shader that stores what each covered
+    /// voxel receives (`glsl/gi/voxelize/coverage.glsl`); `set_layouts` are those of sets
+    /// 0, 1 and 2.
+    pub fn new(
+        ctx: &Arc<Context>,
+        name: &str,
+        fragment: &[u8],
+        set_layouts: [vk::DescriptorSetLayout; 3],
+    ) -> Result<Self> {
         let pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
-                name: "voxelize",
+                name,
                 vertex: crate::vk::shaders::GI_VOXELIZE_VOXELIZE_VERT,
                 geometry: Some(crate::vk::shaders::GI_VOXELIZE_VOXELIZE_GEOM),
-                fragment: Some(crate::vk::shaders::GI_VOXELIZE_VOXELIZE_FRAG),
+                fragment: Some(fragment),
                 vertex_stride: std::mem::size_of::<crate::scene::Vertex>() as u32,
                 attributes: &VERTEX_ATTRIBUTES,
                 set_layouts: &set_layouts,

@@ -165,6 +165,16 @@ pub struct LoadOptions {
     pub no_refraction: bool,
 }
 
+impl LoadOptions {
+    /// The conventions of the path-traced references: Lambertian, no normal maps, `d` a
+    /// straight mask.
+    pub const REFERENCE: Self = Self {
+        diffuse_only: true,
+        no_normal_maps: true,
+        no_refraction: true,
+    };
+}
+
 /// GI settings a scene file may give (`[gi]`); the command line overrides them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -266,7 +276,7 @@ impl Scene {
 
 /// Fixtures shared by the tests of this module's files.
 #[cfg(test)]
-mod testing {
+pub(crate) mod testing {
     use std::path::{Path, PathBuf};
     use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -290,6 +300,17 @@ mod testing {
             );
         }
         found.cloned()
+    }
+
+    /// `path` under the shared folder; `None`, with the reason printed, when absent.
+    pub fn shared_file(path: &str) -> Option<PathBuf> {
+        let file = shared_dir()?.join(path);
+        if file.exists() {
+            Some(file)
+        } else {
+            eprintln!("skipped: {} is absent", file.display());
+            None
+        }
     }
 
     /// A fresh folder under the system temp dir, removed again when dropped.

@@ -5,7 +5,7 @@ use std::sync::Arc;
 use anyhow::{Context as _, Result};
 use ash::vk;
 
-use super::{Context, Image};
+use super::{Buffer, Context, Image};
 
 /// One side of an image barrier: a layout with the stages and accesses that use it.
 #[derive(Clone, Copy, Debug)]
@@ -240,6 +240,95 @@ impl Drop for OneShot {
     fn drop(&mut self) {
         unsafe { self.ctx.device.destroy_command_pool(self.pool, None) };
     }
+}
+
+/// Copies `buffer` (written by any earlier shader) to the host and returns its bytes,
+/// once the GPU is done with it.
+pub fn read_back_buffer(ctx: &Arc<Context>, buffer: &Buffer) -> Result<Vec<u8>> {
+    let readback = Buffer::new(
+        ctx,
+        "readback",
+        buffer.size,
+        vk::BufferUsageFlags::TRANSFER_DST,
+        gpu_allocator::MemoryLocation::GpuToCpu,
+    )?;
+    OneShot::new(ctx)?.run("read back buffer", |cmd| {
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::TRANSFER_READ,
+            ),
+        );
+        let region = vk::BufferCopy::default().size(buffer.size);
+        unsafe {
+            ctx.device
+                .cmd_copy_buffer(cmd, buffer.raw, readback.raw, &[region])
+        };
+        copies_to_host_barrier(ctx, cmd);
+        Ok(())
+    })?;
+    Ok(readback.mapped().to_vec())
+}
+
+/// Copies mip `level` of `image` (its first `extent`, texels x fastest) to the host and
+/// returns its bytes, once the GPU is done with it; the image is in state `around` before
+/// and after.
+pub fn read_back_image(
+    ctx: &Arc<Context>,
+    image: &Image,
+    level: u32,
+    extent: vk::Extent3D,
+    texel_bytes: u64,
+    around: ImageUse,
+) -> Result<Vec<u8>> {
+    let bytes =
+        texel_bytes * u64::from(extent.width) * u64::from(extent.height) * u64::from(extent.depth);
+    let readback = Buffer::new(
+        ctx,
+        "image readback",
+        bytes,
+        vk::BufferUsageFlags::TRANSFER_DST,
+        gpu_allocator::MemoryLocation::GpuToCpu,
+    )?;
+    let range = vk::ImageSubresourceRange {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        base_mip_level: level,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    OneShot::new(ctx)?.run("read back image", |cmd| {
+        image_barrier(ctx, cmd, image.raw, range, around, ImageUse::TRANSFER_SRC);
+        let region = vk::BufferImageCopy {
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: vk::ImageAspectFlags::COLOR,
+                mip_level: level,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_extent: extent,
+            ..Default::default()
+        };
+        unsafe {
+            ctx.device.cmd_copy_image_to_buffer(
+                cmd,
+                image.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                readback.raw,
+                &[region],
+            )
+        };
+        image_barrier(ctx, cmd, image.raw, range, ImageUse::TRANSFER_SRC, around);
+        copies_to_host_barrier(ctx, cmd);
+        Ok(())
+    })?;
+    Ok(readback.mapped().to_vec())
 }
 
 impl ImageUse {

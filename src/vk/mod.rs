@@ -11,7 +11,8 @@ mod sync;
 mod timestamps;
 
 pub use commands::{
-    clear_to_zero, copies_to_host_barrier, image_barrier, memory_barrier, ImageUse, OneShot,
+    clear_to_zero, copies_to_host_barrier, image_barrier, memory_barrier, read_back_buffer,
+    read_back_image, ImageUse, OneShot,
 };
 pub use context::{Context, ContextOptions, Features};
 pub use descriptors::{Binding, DescriptorSets, SetWriter};

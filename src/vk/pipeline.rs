@@ -115,19 +115,20 @@ impl Pipeline {
         };
     }
 
-    /// Binds one more descriptor set to the bound pipeline.
-    /// Binds the pipeline and `sets`, then dispatches the workgroup counts stored at the
-    /// start of `args`.
+    /// Binds the pipeline and `sets`, then dispatches the workgroup counts stored at byte
+    /// `offset` of `args`.
     pub fn dispatch_indirect(
         &self,
         cmd: vk::CommandBuffer,
         sets: &[(u32, vk::DescriptorSet)],
         args: vk::Buffer,
+        offset: vk::DeviceSize,
     ) {
         self.bind(cmd, sets);
-        unsafe { self.ctx.device.cmd_dispatch_indirect(cmd, args, 0) };
+        unsafe { self.ctx.device.cmd_dispatch_indirect(cmd, args, offset) };
     }
 
+    /// Binds one more descriptor set to the bound pipeline.
     pub fn bind_set(&self, cmd: vk::CommandBuffer, index: u32, set: vk::DescriptorSet) {
         unsafe {
             self.ctx.device.cmd_bind_descriptor_sets(

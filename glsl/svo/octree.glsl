@@ -1,0 +1,68 @@
+// Set 2 of the octree passes: the sparse voxel octree's pools (Crassin & Green 2012;
+// Dřínovský 2013, 5.2). Level 0 is the root; a node at level l covers 2^(depth - l)
+// voxels of the effective 2^depth grid along each axis; the leaves, at level depth - 1,
+// hold 2x2x2 voxels in their bricks.
+#ifndef SVO_OCTREE_GLSL
+#define SVO_OCTREE_GLSL
+#include "gi/voxels.glsl"
+
+layout(set = SET_PASS, binding = BINDING_SVO_COUNTERS, std430) buffer CountersBlock {
+    SvoCounters counters;
+    SvoLevel levels[SVO_MAX_LEVELS];
+};
+layout(set = SET_PASS, binding = BINDING_SVO_FRAGMENTS, std430) buffer FragmentsBlock {
+    VoxelFragment fragments[];
+};
+layout(set = SET_PASS, binding = BINDING_SVO_NODES, std430) buffer NodesBlock {
+    uint node_children[];
+};
+layout(set = SET_PASS, binding = BINDING_SVO_NODE_COORDS, std430) buffer CoordsBlock {
+    uint node_coords[];
+};
+layout(set = SET_PASS, binding = BINDING_SVO_NODE_BRICKS, std430) buffer BricksBlock {
+    uint node_bricks[];
+};
+layout(set = SET_PASS, binding = BINDING_SVO_NEIGHBOURS, std430) buffer NeighboursBlock {
+    uint node_neighbours[];
+};
+
+// Mask of a child entry's tile index.
+#define SVO_CHILD_MASK (~SVO_SUBDIVIDE)
+
+uint svo_depth() {
+    return uint(findMSB(gi.resolution));
+}
+
+uint pack_coord(uvec3 c) {
+    return c.x | (c.y << 10) | (c.z << 20);
+}
+
+uvec3 unpack_coord(uint p) {
+    return uvec3(p & 0x3ffu, (p >> 10) & 0x3ffu, p >> 20);
+}
+
+// Which child of its level-`level` ancestor holds voxel `v` (x | y << 1 | z << 2).
+uint child_octant(uvec3 v, uint level) {
+    uvec3 bit = (v >> (svo_depth() - level - 1u)) & 1u;
+    return bit.x | (bit.y << 1) | (bit.z << 2);
+}
+
+// The node at `level` whose cube holds voxel `v` of the effective grid, or SVO_NO_NODE
+// where the octree has no node there (empty space above it).
+uint find_node(uvec3 v, uint level) {
+    uint node = 0u;
+    for (uint l = 0u; l < level; l++) {
+        uint tile = node_children[node] & SVO_CHILD_MASK;
+        if (tile == 0u) {
+            return SVO_NO_NODE;
+        }
+        node = tile + child_octant(v, l);
+    }
+    return node;
+}
+
+// The corner texel of brick `slot` in a pool of `side`³ bricks of `edge`³ texels.
+ivec3 brick_origin(uint slot, uint side, uint edge) {
+    return ivec3(slot % side, (slot / side) % side, slot / (side * side)) * int(edge);
+}
+#endif

@@ -1,0 +1,648 @@
+//! Global illumination on a sparse voxel octree (`--gi svo`; Crassin et al. 2011), built
+//! on the GPU level by level (Crassin & Green 2012) as in Dřínovský's thesis (2013, 5.2-5.4).
+//!
+//! Build: voxel-fragment list (the dense path's voxelization, appending records through
+//! an atomic counter) -> octree, level by level (flag, alloc, init) -> neighbour pointers
+//! -> leaf bricks filled from the fragments. Every pool's capacity is checked on the
+//! GPU; a pool that overflows is reported, grown, and the build runs again.
+
+mod bricks;
+mod octree;
+#[cfg(test)]
+mod tests;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{bail, ensure, Context as _, Result};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+use crate::gi::voxelize::{Meshes, VoxelizePass};
+use crate::gi::{compute_to_compute, emission_range, Grid};
+use crate::gpu_layout::{self as layout, GiUniforms, SvoCounters, SvoLevel, VoxelFragment};
+use crate::scene::Scene;
+use crate::scene_gpu::SceneDraw;
+use crate::vk::{
+    clear_to_zero, copies_to_host_barrier, memory_barrier, Binding, Buffer, Context,
+    DescriptorSets, GpuTimer, Image, ImageDesc, ImageUse, OneShot, SetWriter,
+};
+use bricks::LEAF_BRICK_EDGE;
+
+/// Octree depths `--octree-depth` accepts: effective grids of 64³ to 1024³.
+pub const DEPTHS: std::ops::RangeInclusive<u32> = 6..=10;
+
+/// Checks an octree depth.
+pub fn check_depth(depth: u32) -> Result<()> {
+    if !DEPTHS.contains(&depth) {
+        bail!(
+            "--octree-depth must be between {} and {}, got {depth}",
+            DEPTHS.start(),
+            DEPTHS.end()
+        );
+    }
+    Ok(())
+}
+
+/// How many records each pool holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Capacities {
+    pub fragments: u32,
+    pub nodes: u32,
+    pub leaf_bricks: u32,
+    pub interior_bricks: u32,
+}
+
+impl Capacities {
+    /// A first guess from the scene's surface area: a surface covers about 1.5 voxels
+    /// per voxel face of area (dilation, slopes) and two fragments per voxel (overlapping
+    /// triangles, both sides of thin walls); the octree allocates about 0.7 nodes per
+    /// surface voxel (tiles of 8 children under nodes that hold a quarter of their
+    /// children's voxels). Wrong guesses cost a rebuild, not a wrong image.
+    pub fn estimate(scene: &Scene, grid: &Grid) -> Self {
+        let mut area = 0.0f64;
+        let mut triangles = 0u64;
+        for (m, mesh) in scene.meshes.iter().enumerate() {
+            let model = scene.mesh_transform(m, 0.0);
+            for t in mesh.indices.chunks_exact(3) {
+                let p = [t[0], t[1], t[2]].map(|i| {
+                    model.transform_point3(glam::Vec3::from(mesh.vertices[i as usize].position))
+                });
+                area += f64::from((p[1] - p[0]).cross(p[2] - p[0]).length() * 0.5);
+                triangles += 1;
+            }
+        }
+        let face = f64::from(grid.voxel_size).powi(2);
+        let voxels = (1.5 * area / face + 2.0 * triangles as f64)
+            .min(f64::from(grid.resolution).powi(3))
+            .max(4096.0);
+        let count = |x: f64| x.min(f64::from(u32::MAX / 2)) as u32;
+        Self {
+            fragments: count(2.0 * voxels),
+            nodes: count(0.7 * voxels),
+            leaf_bricks: count(0.35 * voxels),
+            interior_bricks: count(0.1 * voxels),
+        }
+    }
+
+    /// Capacities for another build after `counters` reported an overflow: what the
+    /// full pools needed with a margin, and at least four times the capacity that failed
+    /// (what they report is a lower bound when a pool they depend on ran out too).
+    fn grown(&self, counters: &SvoCounters) -> Self {
+        let grow = |capacity: u32, used: u32, bit: u32| {
+            if counters.overflow & bit == 0 {
+                capacity
+            } else {
+                capacity
+                    .saturating_mul(4)
+                    .max(used.saturating_add(used / 2))
+            }
+        };
+        Self {
+            fragments: grow(
+                self.fragments,
+                counters.fragment_count,
+                layout::SVO_OVERFLOW_FRAGMENTS,
+            ),
+            nodes: grow(self.nodes, counters.node_count, layout::SVO_OVERFLOW_NODES),
+            leaf_bricks: grow(
+                self.leaf_bricks,
+                counters.leaf_bricks,
+                layout::SVO_OVERFLOW_LEAF_BRICKS,
+            ),
+            interior_bricks: grow(
+                self.interior_bricks,
+                counters.interior_bricks,
+                layout::SVO_OVERFLOW_INTERIOR_BRICKS,
+            ),
+        }
+    }
+}
+
+/// Which pools an overflow report names.
+fn overflowed(counters: &SvoCounters, capacities: &Capacities) -> Vec<String> {
+    let pools = [
+        (
+            layout::SVO_OVERFLOW_FRAGMENTS,
+            "voxel-fragment list",
+            counters.fragment_count,
+            capacities.fragments,
+        ),
+        (
+            layout::SVO_OVERFLOW_NODES,
+            "node pool",
+            counters.node_count,
+            capacities.nodes,
+        ),
+        (
+            layout::SVO_OVERFLOW_LEAF_BRICKS,
+            "leaf brick pool",
+            counters.leaf_bricks,
+            capacities.leaf_bricks,
+        ),
+        (
+            layout::SVO_OVERFLOW_INTERIOR_BRICKS,
+            "interior brick pool",
+            counters.interior_bricks,
+            capacities.interior_bricks,
+        ),
+    ];
+    pools
+        .iter()
+        .filter(|(bit, ..)| counters.overflow & bit != 0)
+        .map(|(_, name, used, capacity)| {
+            format!("{name}: {capacity} entries, at least {used} needed")
+        })
+        .collect()
+}
+
+/// The smallest cube of bricks holding `bricks`: bricks per edge of the pool image.
+fn pool_side(bricks: u32) -> u32 {
+    let mut side = (f64::from(bricks.max(1))).cbrt().ceil() as u32;
+    while u64::from(side).pow(3) < u64::from(bricks) {
+        side += 1;
+    }
+    side
+}
+
+/// The octree's pools on the GPU.
+struct Pools {
+    capacities: Capacities,
+    /// `SvoCounters`, then `SvoLevel[SVO_MAX_LEVELS]`; also the indirect dispatches.
+    counters: Buffer,
+    fragments: Buffer,
+    nodes: Buffer,
+    coords: Buffer,
+    bricks: Buffer,
+    neighbours: Buffer,
+    leaf_side: u32,
+    interior_side: u32,
+    /// Leaf-brick attributes: albedo, normal, emission.
+    leaf_attributes: [Image; 3],
+}
+
+const COUNTERS_BYTES: usize = std::mem::size_of::<SvoCounters>()
+    + layout::SVO_MAX_LEVELS as usize * std::mem::size_of::<SvoLevel>();
+
+impl Pools {
+    fn new(ctx: &Arc<Context>, capacities: Capacities, device_limit: u64) -> Result<Self> {
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER
+            | vk::BufferUsageFlags::TRANSFER_SRC
+            | vk::BufferUsageFlags::TRANSFER_DST;
+        let buffer = |name: &str, bytes: u64, extra: vk::BufferUsageFlags| -> Result<Buffer> {
+            ensure!(
+                bytes <= device_limit,
+                "the SVO {name} needs {bytes} bytes, more than the device's largest storage \
+                 buffer ({device_limit} bytes): use a smaller --octree-depth"
+            );
+            Buffer::new(ctx, name, bytes, storage | extra, MemoryLocation::GpuOnly)
+        };
+        let nodes = u64::from(capacities.nodes);
+        let leaf_side = pool_side(capacities.leaf_bricks);
+        let interior_side = pool_side(capacities.interior_bricks);
+        let attribute = |name| {
+            Image::new(
+                ctx,
+                name,
+                ImageDesc::d3(
+                    vk::Format::R32_UINT,
+                    leaf_side * LEAF_BRICK_EDGE,
+                    1,
+                    vk::ImageUsageFlags::STORAGE
+                        | vk::ImageUsageFlags::TRANSFER_DST
+                        | vk::ImageUsageFlags::TRANSFER_SRC,
+                ),
+            )
+        };
+        Ok(Self {
+            capacities,
+            counters: buffer(
+                "svo counters",
+                COUNTERS_BYTES as u64,
+                vk::BufferUsageFlags::INDIRECT_BUFFER,
+            )?,
+            fragments: buffer(
+                "svo fragments",
+                u64::from(capacities.fragments) * std::mem::size_of::<VoxelFragment>() as u64,
+                vk::BufferUsageFlags::empty(),
+            )?,
+            nodes: buffer("svo nodes", 4 * nodes, vk::BufferUsageFlags::empty())?,
+            coords: buffer("svo node coords", 4 * nodes, vk::BufferUsageFlags::empty())?,
+            bricks: buffer("svo node bricks", 4 * nodes, vk::BufferUsageFlags::empty())?,
+            neighbours: buffer("svo neighbours", 24 * nodes, vk::BufferUsageFlags::empty())?,
+            leaf_side,
+            interior_side,
+            leaf_attributes: [
+                attribute("svo leaf albedo")?,
+                attribute("svo leaf normal")?,
+                attribute("svo leaf emission")?,
+            ],
+        })
+    }
+
+    fn write_set(&self, ctx: &Context, set: vk::DescriptorSet) {
+        let storage = vk::DescriptorType::STORAGE_BUFFER;
+        let [albedo, normal, emission] = &self.leaf_attributes;
+        SetWriter::new(ctx, set)
+            .buffer(layout::BINDING_SVO_COUNTERS, storage, self.counters.raw)
+            .buffer(layout::BINDING_SVO_FRAGMENTS, storage, self.fragments.raw)
+            .buffer(layout::BINDING_SVO_NODES, storage, self.nodes.raw)
+            .buffer(layout::BINDING_SVO_NODE_COORDS, storage, self.coords.raw)
+            .buffer(layout::BINDING_SVO_NODE_BRICKS, storage, self.bricks.raw)
+            .buffer(layout::BINDING_SVO_NEIGHBOURS, storage, self.neighbours.raw)
+            .storage_image(layout::BINDING_SVO_BRICK_ALBEDO, albedo.view)
+            .storage_image(layout::BINDING_SVO_BRICK_NORMAL, normal.view)
+            .storage_image(layout::BINDING_SVO_BRICK_EMISSION, emission.view)
+            .apply();
+    }
+
+    fn bytes(&self) -> Vec<(&'static str, u64)> {
+        let [albedo, normal, emission] = &self.leaf_attributes;
+        vec![
+            ("svo_fragments", self.fragments.size),
+            (
+                "svo_node_pool",
+                self.nodes.size + self.coords.size + self.bricks.size + self.neighbours.size,
+            ),
+            (
+                "svo_brick_pool",
+                albedo.memory_bytes() + normal.memory_bytes() + emission.memory_bytes(),
+            ),
+            ("svo_counters", self.counters.size),
+        ]
+    }
+}
+
+/// What a build made, measured: the counters, the level table and GPU time per pass.
+#[derive(Clone, Debug)]
+pub struct BuildReport {
+    pub counters: SvoCounters,
+    /// Levels 0 (the root) to depth - 1 (the leaves).
+    pub levels: Vec<SvoLevel>,
+    /// GPU milliseconds per pass of the last (successful) build.
+    pub passes: Vec<(String, f64)>,
+    /// One line per overflow that made the build run again.
+    pub regrowths: Vec<String>,
+    /// Host time of the whole build, rebuilds included.
+    pub wall_ms: f64,
+}
+
+impl BuildReport {
+    /// The `stats` of `bench`: fragments, nodes per level, bricks, pool use.
+    pub fn stats(&self, capacities: &Capacities) -> Vec<(String, f64)> {
+        let c = &self.counters;
+        let mut stats = vec![
+            ("fragments".to_string(), f64::from(c.fragment_count)),
+            (
+                "fragment_capacity".to_string(),
+                f64::from(capacities.fragments),
+            ),
+            ("nodes_total".to_string(), f64::from(c.node_count)),
+            ("node_capacity".to_string(), f64::from(capacities.nodes)),
+            (
+                "bricks".to_string(),
+                f64::from(c.leaf_bricks + c.interior_bricks),
+            ),
+            ("leaf_bricks".to_string(), f64::from(c.leaf_bricks)),
+            (
+                "leaf_brick_capacity".to_string(),
+                f64::from(capacities.leaf_bricks),
+            ),
+            ("interior_bricks".to_string(), f64::from(c.interior_bricks)),
+            (
+                "interior_brick_capacity".to_string(),
+                f64::from(capacities.interior_bricks),
+            ),
+            (
+                "build_attempts".to_string(),
+                self.regrowths.len() as f64 + 1.0,
+            ),
+            ("build_wall_ms".to_string(), self.wall_ms),
+        ];
+        for (i, level) in self.levels.iter().enumerate() {
+            stats.push((format!("nodes_level_{i}"), f64::from(level.count)));
+        }
+        stats
+    }
+}
+
+/// The set-2 bindings of the octree passes.
+fn svo_bindings() -> Vec<Binding> {
+    let all = vk::ShaderStageFlags::FRAGMENT
+        | vk::ShaderStageFlags::COMPUTE
+        | vk::ShaderStageFlags::GEOMETRY;
+    let storage = vk::DescriptorType::STORAGE_BUFFER;
+    let image = vk::DescriptorType::STORAGE_IMAGE;
+    vec![
+        Binding::new(
+            layout::BINDING_GI_UNIFORMS,
+            vk::DescriptorType::UNIFORM_BUFFER,
+            all,
+        ),
+        Binding::new(layout::BINDING_SVO_COUNTERS, storage, all),
+        Binding::new(layout::BINDING_SVO_FRAGMENTS, storage, all),
+        Binding::new(layout::BINDING_SVO_NODES, storage, all),
+        Binding::new(layout::BINDING_SVO_NODE_COORDS, storage, all),
+        Binding::new(layout::BINDING_SVO_NODE_BRICKS, storage, all),
+        Binding::new(layout::BINDING_SVO_NEIGHBOURS, storage, all),
+        Binding::new(layout::BINDING_SVO_BRICK_ALBEDO, image, all),
+        Binding::new(layout::BINDING_SVO_BRICK_NORMAL, image, all),
+        Binding::new(layout::BINDING_SVO_BRICK_EMISSION, image, all),
+    ]
+}
+
+/// The sparse voxel octree of a scene.
+pub struct SvoGi {
+    /// The effective grid: 2^depth voxels per axis over the dense path's cube.
+    pub grid: Grid,
+    pub depth: u32,
+    pools: Pools,
+    fragments: VoxelizePass,
+    octree: octree::OctreePasses,
+    fill: bricks::FillPass,
+    report: Option<BuildReport>,
+    set: vk::DescriptorSet,
+    _sets: DescriptorSets,
+    /// Referenced by the set.
+    _uniforms: Buffer,
+    ctx: Arc<Context>,
+}
+
+impl SvoGi {
+    /// `set_layouts` are those of sets 0 and 1. `capacities` overrides the first guess of
+    /// the pool sizes (the overflow test starts from tiny pools).
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        depth: u32,
+        capacities: Option<Capacities>,
+        set_layouts: [vk::DescriptorSetLayout; 2],
+    ) -> Result<Self> {
+        check_depth(depth)?;
+        if !ctx.features.geometry_shader || !ctx.features.fragment_stores_and_atomics {
+            bail!(
+                "--gi svo needs geometry shaders and fragment stores/atomics, which {} lacks",
+                ctx.device_name()
+            );
+        }
+        let grid = Grid::around(scene, 1 << depth);
+        let capacities = capacities.unwrap_or_else(|| Capacities::estimate(scene, &grid));
+        let pools = Pools::new(ctx, capacities, storage_limit(ctx))?;
+        let uniforms = GiUniforms {
+            origin: grid.origin.extend(grid.voxel_size).to_array(),
+            resolution: grid.resolution,
+            emission_range: emission_range(scene),
+            ..Default::default()
+        };
+        let uniforms = Buffer::with_data(
+            ctx,
+            "svo uniforms",
+            bytemuck::bytes_of(&uniforms),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let sets = DescriptorSets::new(ctx, "svo", &svo_bindings(), 1)?;
+        let set = sets.allocate("svo")?;
+        SetWriter::new(ctx, set)
+            .buffer(
+                layout::BINDING_GI_UNIFORMS,
+                vk::DescriptorType::UNIFORM_BUFFER,
+                uniforms.raw,
+            )
+            .apply();
+        pools.write_set(ctx, set);
+        let layouts = [set_layouts[0], set_layouts[1], sets.layout];
+        Ok(Self {
+            grid,
+            depth,
+            pools,
+            fragments: VoxelizePass::new(
+                ctx,
+                "svo fragments",
+                crate::vk::shaders::SVO_FRAGMENTS_FRAGMENTS_FRAG,
+                layouts,
+            )?,
+            octree: octree::OctreePasses::new(ctx, layouts)?,
+            fill: bricks::FillPass::new(ctx, layouts)?,
+            report: None,
+            set,
+            _sets: sets,
+            _uniforms: uniforms,
+            ctx: ctx.clone(),
+        })
+    }
+
+    /// The last build's report.
+    pub fn report(&self) -> Option<&BuildReport> {
+        self.report.as_ref()
+    }
+
+    pub fn capacities(&self) -> Capacities {
+        self.pools.capacities
+    }
+
+    /// GPU memory of every octree resource, by name.
+    pub fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
+        self.pools.bytes()
+    }
+
+    /// Builds the octree of the meshes at `draw.time_s` and waits for it. A pool that
+    /// overflows is reported (a warning, and in the report), grown and the build runs
+    /// again.
+    pub fn build(&mut self, draw: &SceneDraw) -> Result<&BuildReport> {
+        let start = Instant::now();
+        let mut regrowths = Vec::new();
+        loop {
+            let mut timer = GpuTimer::new(&self.ctx)?;
+            let readback = Buffer::new(
+                &self.ctx,
+                "svo counters readback",
+                COUNTERS_BYTES as u64,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )?;
+            OneShot::new(&self.ctx)?.run("svo build", |cmd| {
+                timer.reset(cmd);
+                self.record_build(cmd, &mut timer, draw);
+                self.copy_counters(cmd, readback.raw);
+                Ok(())
+            })?;
+            let bytes = readback.mapped();
+            let counters: SvoCounters =
+                bytemuck::pod_read_unaligned(&bytes[..std::mem::size_of::<SvoCounters>()]);
+            if counters.overflow == 0 {
+                let levels = bytes[std::mem::size_of::<SvoCounters>()..COUNTERS_BYTES]
+                    .chunks_exact(std::mem::size_of::<SvoLevel>())
+                    .take(self.depth as usize)
+                    .map(bytemuck::pod_read_unaligned)
+                    .collect();
+                self.report = Some(BuildReport {
+                    counters,
+                    levels,
+                    passes: timer.results()?,
+                    regrowths,
+                    wall_ms: start.elapsed().as_secs_f64() * 1e3,
+                });
+                return Ok(self.report.as_ref().unwrap());
+            }
+            let capacities = self.pools.capacities;
+            let grown = capacities.grown(&counters);
+            let message = format!(
+                "SVO pools too small ({}); growing them and building again",
+                overflowed(&counters, &capacities).join("; ")
+            );
+            log::warn!("{message}");
+            regrowths.push(message);
+            ensure!(
+                regrowths.len() < 8,
+                "the SVO build still overflows after {} regrowths",
+                regrowths.len()
+            );
+            self.pools = Pools::new(&self.ctx, grown, storage_limit(&self.ctx))
+                .context("growing the SVO pools")?;
+            self.pools.write_set(&self.ctx, self.set);
+        }
+    }
+
+    /// Records the whole build: counters reset, fragments, octree, leaf bricks.
+    fn record_build(&self, cmd: vk::CommandBuffer, timer: &mut GpuTimer, draw: &SceneDraw) {
+        let ctx = &self.ctx;
+        let p = &self.pools;
+        let c = &p.capacities;
+        let counters = SvoCounters {
+            fragment_groups_y: 1,
+            fragment_groups_z: 1,
+            fragment_capacity: c.fragments,
+            // The root.
+            node_count: 1,
+            node_capacity: c.nodes,
+            leaf_brick_capacity: c.leaf_bricks,
+            interior_brick_capacity: c.interior_bricks,
+            leaf_pool_side: p.leaf_side,
+            interior_pool_side: p.interior_side,
+            ..Default::default()
+        };
+        let root = SvoLevel {
+            groups_x: 1,
+            groups_y: 1,
+            groups_z: 1,
+            first: 0,
+            count: 1,
+            ..Default::default()
+        };
+        let mut head = bytemuck::bytes_of(&counters).to_vec();
+        head.extend_from_slice(bytemuck::bytes_of(&root));
+        unsafe {
+            ctx.device.cmd_update_buffer(cmd, p.counters.raw, 0, &head);
+            // The root: no children yet, at (0, 0, 0).
+            ctx.device.cmd_fill_buffer(cmd, p.nodes.raw, 0, 4, 0);
+            ctx.device.cmd_fill_buffer(cmd, p.coords.raw, 0, 4, 0);
+        }
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::FRAGMENT_SHADER
+                    | vk::PipelineStageFlags2::COMPUTE_SHADER
+                    | vk::PipelineStageFlags2::DRAW_INDIRECT,
+                vk::AccessFlags2::SHADER_READ
+                    | vk::AccessFlags2::SHADER_WRITE
+                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+            ),
+        );
+
+        timer.begin(cmd, "fragments");
+        self.fragments
+            .record(ctx, cmd, draw, self.set, self.grid.resolution, Meshes::All);
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                vk::AccessFlags2::SHADER_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
+                vk::AccessFlags2::SHADER_READ
+                    | vk::AccessFlags2::SHADER_WRITE
+                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+            ),
+        );
+        timer.end(cmd);
+
+        let sets = [
+            (layout::SET_FRAME, draw.frame_set),
+            (layout::SET_PASS, self.set),
+        ];
+        self.octree
+            .record(ctx, cmd, timer, &sets, p.counters.raw, self.depth);
+
+        timer.begin(cmd, "brick fill");
+        for image in &p.leaf_attributes {
+            clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, BRICK_USE);
+        }
+        self.fill.record(cmd, &sets, p.counters.raw);
+        compute_to_compute(ctx, cmd);
+        timer.end(cmd);
+    }
+
+    /// Copies the counters and the level table to `to` (host-visible) at the end of the
+    /// command buffer.
+    fn copy_counters(&self, cmd: vk::CommandBuffer, to: vk::Buffer) {
+        let ctx = &self.ctx;
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::TRANSFER_READ,
+            ),
+        );
+        let region = vk::BufferCopy::default().size(COUNTERS_BYTES as u64);
+        unsafe {
+            ctx.device
+                .cmd_copy_buffer(cmd, self.pools.counters.raw, to, &[region])
+        };
+        copies_to_host_barrier(ctx, cmd);
+    }
+}
+
+/// How the leaf-brick attribute images are used between passes.
+const BRICK_USE: ImageUse = ImageUse {
+    layout: vk::ImageLayout::GENERAL,
+    stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+    access: vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::SHADER_STORAGE_READ.as_raw()
+            | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
+    ),
+};
+
+/// The largest storage buffer the device binds.
+fn storage_limit(ctx: &Context) -> u64 {
+    u64::from(ctx.properties.limits.max_storage_buffer_range)
+}
+
+#[cfg(test)]
+impl SvoGi {
+    /// Downloads a pool buffer as `u32` words.
+    fn download_words(&self, buffer: &Buffer) -> Result<Vec<u32>> {
+        let bytes = crate::vk::read_back_buffer(&self.ctx, buffer)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+
+    /// Downloads a leaf-brick attribute image (0 albedo, 1 normal, 2 emission), texel
+    /// after texel (x fastest).
+    fn download_leaf_attribute(&self, which: usize) -> Result<Vec<u32>> {
+        let image = &self.pools.leaf_attributes[which];
+        let bytes =
+            crate::vk::read_back_image(&self.ctx, image, 0, image.desc.extent, 4, BRICK_USE)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+}

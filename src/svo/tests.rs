@@ -1,0 +1,375 @@
+//! The octree build against a CPU octree, on the real device with validation on.
+
+use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::{Capacities, SvoGi};
+use crate::frontend::LDR_FORMAT;
+use crate::gi::reference;
+use crate::gpu_layout::{self as layout, VoxelFragment};
+use crate::renderer::{RenderSettings, Renderer, SvoSettings};
+use crate::scene::testing::shared_file;
+use crate::scene::{LoadOptions, Scene};
+use crate::vk::{Context, ContextOptions};
+
+/// A renderer whose octree of `scene` is built at `depth`.
+fn build(scene: Scene, depth: u32, capacities: Option<Capacities>) -> (Arc<Context>, Renderer) {
+    let _ = env_logger::builder().is_test(true).try_init();
+    let ctx = Context::new(&ContextOptions {
+        validation: true,
+        ..Default::default()
+    })
+    .unwrap();
+    let settings = RenderSettings {
+        svo: Some(SvoSettings { depth, capacities }),
+        ..Default::default()
+    };
+    let extent = vk::Extent2D {
+        width: 16,
+        height: 16,
+    };
+    let renderer = Renderer::new(&ctx, scene, settings, extent, LDR_FORMAT).unwrap();
+    (ctx, renderer)
+}
+
+/// The octree as downloaded.
+struct Downloaded {
+    fragments: Vec<VoxelFragment>,
+    /// Per level: (first node, count).
+    levels: Vec<(u32, u32)>,
+    children: Vec<u32>,
+    coords: Vec<[u32; 3]>,
+    bricks: Vec<u32>,
+    neighbours: Vec<u32>,
+}
+
+fn unpack(p: u32) -> [u32; 3] {
+    [p & 0x3ff, (p >> 10) & 0x3ff, p >> 20]
+}
+
+fn download(svo: &SvoGi) -> Downloaded {
+    let report = svo.report().unwrap();
+    let p = &svo.pools;
+    let fragment_words = svo.download_words(&p.fragments).unwrap();
+    let stored = report.counters.fragment_count as usize;
+    Downloaded {
+        fragments: bytemuck::cast_slice(&fragment_words[..4 * stored]).to_vec(),
+        levels: report.levels.iter().map(|l| (l.first, l.count)).collect(),
+        children: svo.download_words(&p.nodes).unwrap(),
+        coords: svo
+            .download_words(&p.coords)
+            .unwrap()
+            .into_iter()
+            .map(unpack)
+            .collect(),
+        bricks: svo.download_words(&p.bricks).unwrap(),
+        neighbours: svo.download_words(&p.neighbours).unwrap(),
+    }
+}
+
+/// The occupied nodes of each level (0 = root) of an octree over `voxels` of a 2^depth
+/// grid: a node at level l covers voxels v with v >> (depth - l) equal to its coordinates.
+fn cpu_octree(voxels: &HashSet<[u32; 3]>, depth: u32) -> Vec<HashSet<[u32; 3]>> {
+    (0..depth)
+        .map(|l| voxels.iter().map(|v| v.map(|c| c >> (depth - l))).collect())
+        .collect()
+}
+
+/// Checks the GPU octree node for node against the CPU octree of its own fragments and
+/// returns those fragments' voxels.
+fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
+    let depth = svo.depth;
+    let voxels: HashSet<[u32; 3]> = d.fragments.iter().map(|f| unpack(f.position)).collect();
+    let cpu = cpu_octree(&voxels, depth);
+    // Level l + 1 holds a tile of 8 children under every occupied node of level l.
+    for (l, &(first, count)) in d.levels.iter().enumerate() {
+        let expected = if l == 0 { 1 } else { 8 * cpu[l - 1].len() };
+        assert_eq!(count as usize, expected, "level {l}: node count");
+        let previous_end = if l == 0 {
+            0
+        } else {
+            d.levels[l - 1].0 + d.levels[l - 1].1
+        };
+        assert_eq!(
+            first,
+            previous_end,
+            "level {l} follows level {}",
+            l.max(1) - 1
+        );
+    }
+    let total: u32 = d.levels.iter().map(|l| l.1).sum();
+    assert_eq!(total, svo.report().unwrap().counters.node_count);
+
+    let mut by_coords: Vec<HashMap<[u32; 3], u32>> = Vec::new();
+    let mut leaf_bricks = HashSet::new();
+    let mut interior_bricks = HashSet::new();
+    for (l, &(first, count)) in d.levels.iter().enumerate() {
+        let mut map = HashMap::new();
+        for node in first..first + count {
+            let c = d.coords[node as usize];
+            assert!(
+                map.insert(c, node).is_none(),
+                "level {l}: two nodes at {c:?}"
+            );
+            let occupied = cpu[l].contains(&c);
+            let brick = d.bricks[node as usize];
+            assert_eq!(
+                brick != layout::SVO_NO_BRICK,
+                occupied,
+                "level {l} node {node} brick"
+            );
+            if occupied {
+                let fresh = if l + 1 == depth as usize {
+                    leaf_bricks.insert(brick)
+                } else {
+                    interior_bricks.insert(brick)
+                };
+                assert!(fresh, "brick {brick} given twice");
+            }
+            let tile = d.children[node as usize];
+            assert_eq!(tile & layout::SVO_SUBDIVIDE, 0, "flag left set");
+            if occupied && l + 1 < depth as usize {
+                let (next_first, next_count) = d.levels[l + 1];
+                assert!(
+                    tile >= next_first && tile + 8 <= next_first + next_count,
+                    "level {l} node {node}: children {tile} outside level {}",
+                    l + 1
+                );
+                assert_eq!((tile - next_first) % 8, 0, "tiles of 8");
+                for o in 0..8u32 {
+                    let expected = [
+                        2 * c[0] + (o & 1),
+                        2 * c[1] + ((o >> 1) & 1),
+                        2 * c[2] + (o >> 2),
+                    ];
+                    assert_eq!(d.coords[(tile + o) as usize], expected);
+                }
+            } else {
+                assert_eq!(tile, 0, "level {l} node {node}: children without voxels");
+            }
+        }
+        by_coords.push(map);
+    }
+    let counters = svo.report().unwrap().counters;
+    assert_eq!(leaf_bricks.len() as u32, counters.leaf_bricks);
+    assert_eq!(interior_bricks.len() as u32, counters.interior_bricks);
+
+    // Neighbours: the node at the next coordinates of the same level, and symmetric.
+    let mut links = 0;
+    for (l, map) in by_coords.iter().enumerate() {
+        for (c, &node) in map {
+            for dir in 0..6 {
+                let axis = dir / 2;
+                let mut n = c.map(i64::from);
+                n[axis] += if dir % 2 == 0 { 1 } else { -1 };
+                let expected = u32::try_from(n[axis])
+                    .ok()
+                    .and_then(|_| map.get(&n.map(|x| x as u32)).copied())
+                    .unwrap_or(layout::SVO_NO_NODE);
+                let got = d.neighbours[6 * node as usize + dir];
+                assert_eq!(got, expected, "level {l} node {node} neighbour {dir}");
+                if got != layout::SVO_NO_NODE {
+                    let back = d.neighbours[6 * got as usize + (dir ^ 1)];
+                    assert_eq!(back, node, "neighbour links are symmetric");
+                    links += 1;
+                }
+            }
+        }
+    }
+    eprintln!(
+        "depth {depth}: {} fragments, {} voxels, nodes per level {:?}, {} neighbour links",
+        d.fragments.len(),
+        voxels.len(),
+        d.levels.iter().map(|l| l.1).collect::<Vec<_>>(),
+        links
+    );
+    voxels
+}
+
+/// The octree of `scene` at `depth`: its structure against a CPU octree, its voxels
+/// against the CPU reference voxelizer. Cut-out triangles (map_d) count only as places
+/// where voxels may be: the CPU does not sample their textures.
+fn check_octree(scene: Scene, depth: u32) {
+    let triangles = reference::world_triangles(&scene);
+    let solid = reference::world_triangles_where(&scene, |m| m.coverage_texture.is_none());
+    let (ctx, renderer) = build(scene, depth, None);
+    let svo = renderer.svo().unwrap();
+    let d = download(svo);
+    let voxels = check_structure(svo, &d);
+
+    // The fragments' voxels: every voxel a triangle touches (the CPU reference
+    // voxelizer), and none farther than one voxel from a triangle.
+    let grid = svo.grid;
+    let exact = reference::voxelize(&solid, &grid);
+    let near = reference::within_one_voxel(&triangles, &grid);
+    let index = |v: &[u32; 3]| grid.index(v[0], v[1], v[2]);
+    let mut cpu_voxels = HashSet::new();
+    for k in 0..grid.resolution {
+        for j in 0..grid.resolution {
+            for i in 0..grid.resolution {
+                if exact[grid.index(i, j, k)] {
+                    cpu_voxels.insert([i, j, k]);
+                }
+            }
+        }
+    }
+    let missing = cpu_voxels.difference(&voxels).count();
+    let too_far = voxels.iter().filter(|v| !near[index(v)]).count();
+    // The octree of the CPU reference voxels, level by level, against the GPU's (equal
+    // unless a conservative extra voxel or a cut-out opens a node of its own).
+    let cpu = cpu_octree(&cpu_voxels, svo.depth);
+    let gpu = cpu_octree(&voxels, svo.depth);
+    for (l, (c, g)) in cpu.iter().zip(&gpu).enumerate() {
+        eprintln!(
+            "level {l}: CPU reference octree {} occupied nodes, GPU {}",
+            c.len(),
+            g.len()
+        );
+        assert!(
+            c.is_subset(g),
+            "level {l}: a node of the CPU octree is missing"
+        );
+    }
+    assert_eq!(missing, 0, "voxels the CPU marks but no fragment covers");
+    assert_eq!(
+        too_far, 0,
+        "fragments farther than one voxel from every triangle"
+    );
+    assert_eq!(ctx.validation_messages(), 0);
+}
+
+fn cornell() -> Option<Scene> {
+    let path = shared_file("scenes/cornell_box/CornellBox-Original.obj")?;
+    Some(Scene::load(&path, &LoadOptions::default()).unwrap())
+}
+
+#[test]
+fn octree_matches_cpu_octree_on_cornell_box() {
+    let Some(scene) = cornell() else { return };
+    for depth in [6, 7] {
+        check_octree(scene.clone(), depth);
+    }
+}
+
+#[test]
+fn octree_matches_cpu_octree_on_sponza() {
+    let Some(path) = shared_file("scenes/crytek_sponza/sponza.obj") else {
+        return;
+    };
+    let options = LoadOptions::REFERENCE;
+    check_octree(Scene::load(&path, &options).unwrap(), 7);
+}
+
+/// Unpacks an RGBA8 word.
+fn rgba(v: u32) -> [f32; 4] {
+    [v & 0xff, (v >> 8) & 0xff, (v >> 16) & 0xff, v >> 24].map(|c| c as f32)
+}
+
+/// Every leaf-brick voxel holds the mean of its fragments' albedo, normal and emission;
+/// voxels without fragments are empty.
+#[test]
+fn leaf_bricks_average_their_fragments() {
+    let Some(scene) = cornell() else { return };
+    let (ctx, renderer) = build(scene, 6, None);
+    let svo = renderer.svo().unwrap();
+    let d = download(svo);
+    let depth = svo.depth;
+    let (leaf_first, leaf_count) = d.levels[depth as usize - 1];
+    let leaf_of: HashMap<[u32; 3], u32> = (leaf_first..leaf_first + leaf_count)
+        .map(|n| (d.coords[n as usize], n))
+        .collect();
+    let side = svo.pools.leaf_side;
+    let edge = side * super::LEAF_BRICK_EDGE;
+    let texel_of = |v: [u32; 3]| -> usize {
+        let brick = d.bricks[leaf_of[&v.map(|c| c >> 1)] as usize];
+        let origin = [brick % side, (brick / side) % side, brick / (side * side)];
+        let t = [0, 1, 2].map(|a| origin[a] * super::LEAF_BRICK_EDGE + (v[a] & 1));
+        (t[0] + edge * (t[1] + edge * t[2])) as usize
+    };
+    let mut sums: HashMap<usize, ([[f64; 3]; 3], u32)> = HashMap::new();
+    for f in &d.fragments {
+        let entry = sums.entry(texel_of(unpack(f.position))).or_default();
+        for (a, word) in [f.albedo, f.normal, f.emission].into_iter().enumerate() {
+            for c in 0..3 {
+                entry.0[a][c] += f64::from(rgba(word)[c]);
+            }
+        }
+        entry.1 += 1;
+    }
+    let mut worst = [0.0f64; 3];
+    for (a, name) in ["albedo", "normal", "emission"].iter().enumerate() {
+        let texels = svo.download_leaf_attribute(a).unwrap();
+        for (t, &word) in texels.iter().enumerate() {
+            let got = rgba(word);
+            match sums.get(&t) {
+                None => assert_eq!(word, 0, "{name}: texel {t} without fragments is not empty"),
+                Some((sum, count)) => {
+                    assert_eq!(got[3] as u32, (*count).min(255), "{name}: fragment count");
+                    for c in 0..3 {
+                        let mean = sum[a][c] / f64::from(*count);
+                        worst[a] = worst[a].max((f64::from(got[c]) - mean).abs());
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{} voxels from {} fragments; largest difference from the CPU mean (of 255): albedo {:.2}, normal {:.2}, emission {:.2}",
+        sums.len(),
+        d.fragments.len(),
+        worst[0],
+        worst[1],
+        worst[2]
+    );
+    // An RGBA8 running average rounds at every step: within 1.5 of the exact mean.
+    assert!(worst.iter().all(|w| *w <= 1.5), "{worst:?}");
+    assert_eq!(ctx.validation_messages(), 0);
+}
+
+/// Pools far too small are reported, grown and the build runs again, giving the octree
+/// a build with room to spare gives.
+#[test]
+fn tiny_pools_grow_and_rebuild() {
+    let Some(scene) = cornell() else { return };
+    let tiny = Capacities {
+        fragments: 64,
+        nodes: 9,
+        leaf_bricks: 1,
+        interior_bricks: 1,
+    };
+    let (ctx, grown) = build(scene.clone(), 6, Some(tiny));
+    let (_, roomy) = build(scene, 6, None);
+    let (a, b) = (grown.svo().unwrap(), roomy.svo().unwrap());
+    let report = a.report().unwrap();
+    eprintln!("{}", report.regrowths.join("\n"));
+    assert!(!report.regrowths.is_empty());
+    assert!(report.regrowths[0].contains("voxel-fragment list: 64 entries"));
+    let named = ["node pool", "leaf brick pool", "interior brick pool"];
+    for pool in named {
+        assert!(
+            report.regrowths.iter().any(|r| r.contains(pool)),
+            "no report names the {pool}"
+        );
+    }
+    let (ca, cb) = (report.counters, b.report().unwrap().counters);
+    assert_eq!(
+        (
+            ca.fragment_count,
+            ca.node_count,
+            ca.leaf_bricks,
+            ca.interior_bricks
+        ),
+        (
+            cb.fragment_count,
+            cb.node_count,
+            cb.leaf_bricks,
+            cb.interior_bricks
+        )
+    );
+    let (da, db) = (download(a), download(b));
+    assert_eq!(da.levels, db.levels);
+    check_structure(a, &da);
+    assert_eq!(ctx.validation_messages(), 0);
+}
