@@ -53,6 +53,44 @@ fn const_name(relative: &Path) -> String {
         .collect()
 }
 
+/// Vulkan 1.3 / SPIR-V 1.5, optimized, with debug info; `#include` resolves
+/// `gpu_layout.glsl` to `layout_header`, other names beside the includer or under `glsl_dir`.
+fn compile_options<'a>(glsl_dir: &Path, layout_header: &str) -> shaderc::CompileOptions<'a> {
+    let mut options = shaderc::CompileOptions::new().unwrap();
+    options.set_target_env(
+        shaderc::TargetEnv::Vulkan,
+        shaderc::EnvVersion::Vulkan1_3 as u32,
+    );
+    // SPIR-V 1.6 turns `discard` into demote-to-helper, an optional feature.
+    options.set_target_spirv(shaderc::SpirvVersion::V1_5);
+    options.set_optimization_level(shaderc::OptimizationLevel::Performance);
+    options.set_generate_debug_info();
+    let glsl_dir = glsl_dir.to_path_buf();
+    let layout_header = layout_header.to_string();
+    options.set_include_callback(move |name, _kind, includer, _depth| {
+        if name == "gpu_layout.glsl" {
+            return Ok(shaderc::ResolvedInclude {
+                resolved_name: "gpu_layout.glsl".into(),
+                content: layout_header.clone(),
+            });
+        }
+        let beside = Path::new(includer).parent().map(|p| p.join(name));
+        let candidates = beside.into_iter().chain([glsl_dir.join(name)]);
+        for candidate in candidates {
+            if let Ok(content) = std::fs::read_to_string(&candidate) {
+                return Ok(shaderc::ResolvedInclude {
+                    resolved_name: candidate.to_string_lossy().into_owned(),
+                    content,
+                });
+            }
+        }
+        Err(format!(
+            "cannot find include \"{name}\" (looked beside {includer} and in glsl/)"
+        ))
+    });
+    options
+}
+
 fn main() {
     let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap());
     let glsl_dir = root.join("glsl");
@@ -79,58 +117,44 @@ fn main() {
             .unwrap()
             .1;
         let source = std::fs::read_to_string(path).unwrap();
-        let mut options = shaderc::CompileOptions::new().unwrap();
-        options.set_target_env(
-            shaderc::TargetEnv::Vulkan,
-            shaderc::EnvVersion::Vulkan1_3 as u32,
+        // `// variant: MACRO` lines ask for one more compile with MACRO defined, named
+        // with a `_MACRO` suffix (the octree's variants of the dense GI passes).
+        let variants = std::iter::once(None).chain(
+            source
+                .lines()
+                .filter_map(|l| l.trim().strip_prefix("// variant:"))
+                .map(|m| Some(m.trim().to_string())),
         );
-        // SPIR-V 1.6 turns `discard` into demote-to-helper, an optional feature.
-        options.set_target_spirv(shaderc::SpirvVersion::V1_5);
-        options.set_optimization_level(shaderc::OptimizationLevel::Performance);
-        options.set_generate_debug_info();
-        let glsl_dir = glsl_dir.clone();
-        let layout_header = layout_header.clone();
-        options.set_include_callback(move |name, _kind, includer, _depth| {
-            if name == "gpu_layout.glsl" {
-                return Ok(shaderc::ResolvedInclude {
-                    resolved_name: "gpu_layout.glsl".into(),
-                    content: layout_header.clone(),
-                });
+        for variant in variants {
+            let name = match &variant {
+                Some(m) => format!("{}_{m}", const_name(relative)),
+                None => const_name(relative),
+            };
+            let mut options = compile_options(&glsl_dir, &layout_header);
+            if let Some(m) = &variant {
+                options.add_macro_definition(m, None);
             }
-            let beside = Path::new(includer).parent().map(|p| p.join(name));
-            let candidates = beside.into_iter().chain([glsl_dir.join(name)]);
-            for candidate in candidates {
-                if let Ok(content) = std::fs::read_to_string(&candidate) {
-                    return Ok(shaderc::ResolvedInclude {
-                        resolved_name: candidate.to_string_lossy().into_owned(),
-                        content,
-                    });
-                }
-            }
-            Err(format!(
-                "cannot find include \"{name}\" (looked beside {includer} and in glsl/)"
-            ))
-        });
-        let display = path.to_string_lossy().into_owned();
-        match compiler.compile_into_spirv(&source, kind, &display, "main", Some(&options)) {
-            Ok(artifact) => {
-                if artifact.get_num_warnings() > 0 {
-                    for line in artifact.get_warning_messages().lines() {
-                        println!("cargo:warning={line}");
+            let display = path.to_string_lossy().into_owned();
+            match compiler.compile_into_spirv(&source, kind, &display, "main", Some(&options)) {
+                Ok(artifact) => {
+                    if artifact.get_num_warnings() > 0 {
+                        for line in artifact.get_warning_messages().lines() {
+                            println!("cargo:warning={line}");
+                        }
                     }
+                    let spv = out_dir.join(format!("{name}.spv"));
+                    std::fs::write(&spv, artifact.as_binary_u8()).unwrap();
+                    let with = variant.map(|m| format!(" with {m}")).unwrap_or_default();
+                    writeln!(
+                        module,
+                        "/// SPIR-V of `glsl/{}`{with}.\npub const {name}: &[u8] = include_bytes!({:?});",
+                        relative.display(),
+                        spv
+                    )
+                    .unwrap();
                 }
-                let spv = out_dir.join(format!("{}.spv", const_name(relative)));
-                std::fs::write(&spv, artifact.as_binary_u8()).unwrap();
-                writeln!(
-                    module,
-                    "/// SPIR-V of `glsl/{}`.\npub const {}: &[u8] = include_bytes!({:?});",
-                    relative.display(),
-                    const_name(relative),
-                    spv
-                )
-                .unwrap();
+                Err(e) => failures.push(e.to_string()),
             }
-            Err(e) => failures.push(e.to_string()),
         }
     }
     if !failures.is_empty() {

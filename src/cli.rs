@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use crate::gi::{check_voxels, ConeSettings, DEFAULT_VOXELS};
-use crate::renderer::{DebugView, GiSettings, RenderSettings, SvoSettings, Terms, Tonemap};
+use crate::gi::{check_voxels, ConeSettings, VoxelStructure, DEFAULT_VOXELS};
+use crate::renderer::{DebugView, GiSettings, RenderSettings, Terms, Tonemap};
 use crate::scene::{GiOverrides, LoadOptions};
 use crate::svo::check_depth;
 
@@ -41,8 +41,8 @@ pub enum GiMode {
     /// Voxel cone tracing on a dense voxel grid in 3D textures.
     #[default]
     Dense,
-    /// The sparse voxel octree. Work in progress: `bench` builds it and reports its
-    /// statistics; its cone tracing is not written yet, so `render` and `view` refuse it.
+    /// Voxel cone tracing on a sparse voxel octree built on the GPU, with bricks in 3D
+    /// textures (static scenes only for now).
     Svo,
 }
 
@@ -291,37 +291,42 @@ impl CommonArgs {
         };
         let voxels = self.voxels.or(scene.voxels).unwrap_or(DEFAULT_VOXELS);
         let shadow_cones = self.shadow_cones || scene.shadow_cones.unwrap_or(false);
-        let octree_depth = self.octree_depth.unwrap_or(voxels.trailing_zeros());
         if self.octree_depth.is_some() && self.gi != GiMode::Svo {
             bail!("--octree-depth sets the sparse voxel octree: it needs --gi svo");
         }
-        let mut svo = None;
         let gi = match self.gi {
-            GiMode::Dense => {
+            GiMode::Dense | GiMode::Svo => {
                 cones.check()?;
+                let (voxels, structure) = if self.gi == GiMode::Svo {
+                    if self.debug_view.shows_voxels() {
+                        bail!(
+                            "--debug-view {:?}: the voxel debug views need --gi dense",
+                            self.debug_view
+                        );
+                    }
+                    let depth = self.octree_depth.unwrap_or(voxels.trailing_zeros());
+                    check_depth(depth)?;
+                    (1 << depth, VoxelStructure::Octree { capacities: None })
+                } else {
+                    (voxels, VoxelStructure::Dense)
+                };
                 check_voxels(voxels)?;
                 Some(GiSettings {
                     voxels,
+                    structure,
                     cones,
                     shadow_cones,
                     full_update: self.full_update,
                 })
             }
-            GiMode::Off | GiMode::Svo => {
+            GiMode::Off => {
                 let needs_gi = [
                     (self.shadow_cones, "--shadow-cones"),
                     (self.full_update, "--full-update"),
                     (self.debug_view != DebugView::None, "--debug-view"),
                 ];
                 if let Some((_, option)) = needs_gi.iter().find(|(set, _)| *set) {
-                    bail!("{option} works on the voxels: it needs --gi dense");
-                }
-                if self.gi == GiMode::Svo {
-                    check_depth(octree_depth)?;
-                    svo = Some(SvoSettings {
-                        depth: octree_depth,
-                        capacities: None,
-                    });
+                    bail!("{option} works on the voxels: it needs --gi dense or --gi svo");
                 }
                 None
             }
@@ -344,7 +349,6 @@ impl CommonArgs {
             debug_view: self.debug_view,
             debug_level: self.debug_level,
             gi,
-            svo,
         })
     }
 

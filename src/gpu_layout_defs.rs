@@ -45,18 +45,18 @@ gpu_layout! {
 
         /// GI passes (set 2): `GiUniforms` uniform buffer.
         BINDING_GI_UNIFORMS = 0;
-        /// GI passes (set 2): voxel albedo, RGBA8 moving average packed in `r32ui`.
+        /// GI passes (set 2): voxel albedo, RGBA8 moving average packed in `r32ui` (the octree: its leaf attribute bricks, here and in the next two).
         BINDING_GI_ALBEDO = 1;
         /// GI passes (set 2): voxel normal (xyz * 0.5 + 0.5), RGBA8 moving average in `r32ui`.
         BINDING_GI_NORMAL = 2;
         /// GI passes (set 2): voxel emission / `GiUniforms.emission_range`, RGBA8 in `r32ui`.
         BINDING_GI_EMISSION = 3;
-        /// GI passes (set 2): voxel radiance, premultiplied by opacity, `rgba16f` storage.
+        /// GI passes (set 2): voxel radiance, premultiplied by opacity, `rgba16f` storage (the octree: its leaf radiance bricks).
         BINDING_GI_RADIANCE = 4;
         /// GI passes (set 2): voxel radiance, `sampler3D`.
         BINDING_GI_RADIANCE_SAMPLED = 5;
         /// GI passes (set 2): the six directional mip volumes side by side along x
-        /// (+X -X +Y -Y +Z -Z), `sampler3D`.
+        /// (+X -X +Y -Y +Z -Z), `sampler3D` (the octree: its interior bricks, likewise).
         BINDING_GI_DIRECTIONAL = 6;
         /// GI passes (set 2): screen radiance, read and added to, `rgba32f` storage.
         BINDING_GI_SCREEN = 7;
@@ -98,30 +98,26 @@ gpu_layout! {
         /// Workgroup edge of the 3D compute passes.
         VOXEL_GROUP_SIZE = 4;
 
-        /// SVO passes (set 2; `BINDING_GI_UNIFORMS` holds the `GiUniforms` of the
-        /// effective grid): `SvoCounters` then `SvoLevel[SVO_MAX_LEVELS]`, storage buffer.
-        BINDING_SVO_COUNTERS = 1;
+        /// SVO passes (set 2, beside the GI bindings, which hold the octree's pools where
+        /// the dense grid holds volumes): `SvoCounters` then `SvoLevel[SVO_MAX_LEVELS]`,
+        /// storage buffer.
+        BINDING_SVO_COUNTERS = 20;
         /// SVO passes (set 2): the voxel-fragment list, `VoxelFragment[]` storage buffer.
-        BINDING_SVO_FRAGMENTS = 2;
-        /// SVO passes (set 2): per node, its first child (children come in tiles of 8;
-        /// 0 = none) with `SVO_SUBDIVIDE` set while flagged, `uint[]` storage buffer.
-        BINDING_SVO_NODES = 3;
-        /// SVO passes (set 2): per node, its coordinates among its level's nodes
-        /// (x | y << 10 | z << 20), `uint[]` storage buffer.
-        BINDING_SVO_NODE_COORDS = 4;
-        /// SVO passes (set 2): per node, its brick (`SVO_NO_BRICK` for an empty node),
-        /// in the leaf pool for leaves, in the interior pool otherwise, `uint[]` storage buffer.
-        BINDING_SVO_NODE_BRICKS = 5;
-        /// SVO passes (set 2): per node, its six neighbours at its level (+X -X +Y -Y +Z
-        /// -Z; `SVO_NO_NODE` where none), `uint[]` storage buffer.
-        BINDING_SVO_NEIGHBOURS = 6;
-        /// SVO passes (set 2): leaf-brick albedo (2x2x2 voxels per brick), RGBA8 moving
-        /// average packed in `r32ui`, storage image.
-        BINDING_SVO_BRICK_ALBEDO = 7;
-        /// SVO passes (set 2): leaf-brick normal (xyz * 0.5 + 0.5), RGBA8 in `r32ui`.
-        BINDING_SVO_BRICK_NORMAL = 8;
-        /// SVO passes (set 2): leaf-brick emission / `GiUniforms.emission_range`, RGBA8 in `r32ui`.
-        BINDING_SVO_BRICK_EMISSION = 9;
+        BINDING_SVO_FRAGMENTS = 21;
+        /// SVO passes (set 2): per node, its first child (children come in tiles of 8; 0 = none) with `SVO_SUBDIVIDE` set while flagged, `uint[]` storage buffer.
+        BINDING_SVO_NODES = 22;
+        /// SVO passes (set 2): per node, its coordinates among its level's nodes (x | y << 10 | z << 20), `uint[]` storage buffer.
+        BINDING_SVO_NODE_COORDS = 23;
+        /// SVO passes (set 2): per node, its brick (`SVO_NO_BRICK` for an empty node), in the leaf pools for leaves, in the interior pool otherwise, `uint[]` storage buffer.
+        BINDING_SVO_NODE_BRICKS = 24;
+        /// SVO passes (set 2): per node, its six neighbours at its level (+X -X +Y -Y +Z -Z; `SVO_NO_NODE` where none), `uint[]` storage buffer.
+        BINDING_SVO_NEIGHBOURS = 25;
+        /// SVO passes (set 2): the interior bricks' six directional radiances, `rgba16f` storage (sampled at `BINDING_GI_DIRECTIONAL`).
+        BINDING_SVO_DIRECTIONAL_STORAGE = 26;
+        /// Edge of a leaf attribute brick (albedo, normal, emission, direct light): the leaf's 2x2x2 voxels.
+        SVO_ATTRIBUTE_BRICK = 2;
+        /// Edge of a radiance brick: the node's 2x2x2 voxels and a border of one voxel copied from the neighbours, so that trilinear filtering inside the node needs no other brick.
+        SVO_RADIANCE_BRICK = 4;
         /// Octree levels the level table has room for (depth 10 uses 10).
         SVO_MAX_LEVELS = 16;
         /// Workgroup size of the passes over fragments and over a level's nodes.

@@ -11,13 +11,12 @@ use gpu_allocator::MemoryLocation;
 
 use crate::composite::CompositePass;
 use crate::gbuffer::{GBuffer, GBufferPass};
-use crate::gi::{ConeSettings, DenseGi};
+use crate::gi::{ConeSettings, VoxelGi, VoxelStructure};
 use crate::gpu_layout::{self as layout, FrameUniforms, GpuLight, ShadowView};
 use crate::lighting::LightingPass;
 use crate::scene::{Camera, LightKind, Scene};
 use crate::scene_gpu::{GpuScene, SceneDraw};
 use crate::shadow::{self, ShadowPass};
-use crate::svo::{Capacities, SvoGi};
 use crate::vk::{
     copies_to_host_barrier, image_barrier, sampler_info, Binding, Buffer, Context, DescriptorSets,
     Frame, FrameRing, GpuTimer, Image, ImageUse, Sampler, SetWriter,
@@ -33,26 +32,18 @@ pub enum Tonemap {
     Aces,
 }
 
-/// Global illumination on a dense voxel grid.
+/// Global illumination by voxel cone tracing.
 #[derive(Clone, Copy, Debug)]
 pub struct GiSettings {
-    /// Voxels per axis (a power of two).
+    /// Voxels per axis (a power of two): of the dense grid, or effective of the octree.
     pub voxels: u32,
+    pub structure: VoxelStructure,
     pub cones: ConeSettings,
     /// Direct light shadowed by soft-shadow cones through the voxels instead of by the
     /// shadow maps (which still light the voxels).
     pub shadow_cones: bool,
     /// Re-voxelize and re-shade the static geometry every frame too (benchmarks).
     pub full_update: bool,
-}
-
-/// The sparse voxel octree.
-#[derive(Clone, Copy, Debug)]
-pub struct SvoSettings {
-    /// Levels of nodes: an effective grid of 2^depth voxels per axis.
-    pub depth: u32,
-    /// Pool sizes to start from instead of the estimate from the scene.
-    pub capacities: Option<Capacities>,
 }
 
 /// The terms of the final image; each can be switched.
@@ -148,9 +139,6 @@ pub struct RenderSettings {
     pub cache_shadows: bool,
     /// Indirect light; `None` for direct light only.
     pub gi: Option<GiSettings>,
-    /// Build the sparse voxel octree (`--gi svo`). Its cone tracing is not written yet,
-    /// so the frames themselves show direct light only.
-    pub svo: Option<SvoSettings>,
     pub terms: Terms,
     /// Needs `gi`.
     pub debug_view: DebugView,
@@ -168,7 +156,6 @@ impl Default for RenderSettings {
             shadow_resolution: 1024,
             cache_shadows: true,
             gi: None,
-            svo: None,
             terms: Terms::default(),
             debug_view: DebugView::None,
             debug_level: 0,
@@ -215,8 +202,7 @@ pub struct Renderer {
     lighting: LightingPass,
     gbuffer_pass: GBufferPass,
     shadow: ShadowPass,
-    gi: Option<DenseGi>,
-    svo: Option<SvoGi>,
+    gi: Option<VoxelGi>,
     /// Whether the GI passes run (the viewer's toggle).
     indirect: bool,
     /// Light views and mesh transforms the shadow maps were last rendered with.
@@ -284,7 +270,7 @@ impl Renderer {
         let composite = CompositePass::new(ctx, set_layouts, output_format)?;
         let gi = settings
             .gi
-            .map(|g| DenseGi::new(ctx, &scene, g.voxels, g.cones, g.full_update, set_layouts))
+            .map(|g| VoxelGi::new(ctx, &scene, &g, set_layouts))
             .transpose()?;
         let nearest_sampler = Sampler::new(
             ctx,
@@ -375,7 +361,6 @@ impl Renderer {
             gbuffer_pass,
             shadow,
             gi,
-            svo: None,
             indirect: true,
             shadow_inputs: None,
             frames,
@@ -387,17 +372,14 @@ impl Renderer {
             ctx: ctx.clone(),
         };
         renderer.bind_targets()?;
-        if let Some(svo) = renderer.settings.svo {
-            let mut octree =
-                SvoGi::new(ctx, &renderer.scene, svo.depth, svo.capacities, set_layouts)?;
+        if let Some(gi) = &mut renderer.gi {
             let draw = SceneDraw {
                 scene: &renderer.scene,
                 gpu: &renderer.gpu,
                 frame_set: renderer.frames[0].set,
                 time_s: 0.0,
             };
-            octree.build(&draw)?;
-            renderer.svo = Some(octree);
+            gi.prepare(&draw)?;
         }
         Ok(renderer)
     }
@@ -449,24 +431,16 @@ impl Renderer {
         }
     }
 
-    /// The dense voxel GI, when enabled.
-    pub fn dense_gi(&self) -> Option<&DenseGi> {
+    /// The voxel GI, when enabled.
+    pub fn gi(&self) -> Option<&VoxelGi> {
         self.gi.as_ref()
-    }
-
-    /// The sparse voxel octree, when enabled.
-    pub fn svo(&self) -> Option<&SvoGi> {
-        self.svo.as_ref()
     }
 
     /// GPU memory of the voxel volumes or of the octree, by name (empty without GI).
     pub fn gi_memory_bytes(&self) -> Vec<(&'static str, u64)> {
-        let mut bytes = self
-            .gi
+        self.gi
             .as_ref()
-            .map_or_else(Vec::new, DenseGi::memory_bytes);
-        bytes.extend(self.svo.iter().flat_map(SvoGi::memory_bytes));
-        bytes
+            .map_or_else(Vec::new, VoxelGi::memory_bytes)
     }
 
     /// Bytes of GPU memory held by scene textures.

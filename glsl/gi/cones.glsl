@@ -3,20 +3,7 @@
 #ifndef CONES_GLSL
 #define CONES_GLSL
 #include "common/frame.glsl"
-#include "gi/voxels.glsl"
-
-layout(set = SET_PASS, binding = BINDING_GI_RADIANCE_SAMPLED) uniform sampler3D voxel_radiance;
-layout(set = SET_PASS, binding = BINDING_GI_DIRECTIONAL) uniform sampler3D voxel_directional;
-
-// The directional volume d (+X -X +Y -Y +Z -Z) at `uvw` and mip `level`. The six sit side
-// by side along x; x is kept half a texel (of the coarser level filtered) inside the
-// volume so that filtering never mixes two directions.
-vec4 sample_directional(int d, vec3 uvw, float level) {
-    float edge = float(max(int(gi.resolution) >> (int(ceil(level)) + 1), 1));
-    float margin = 0.5 / edge;
-    vec3 packed_uvw = vec3((float(d) + clamp(uvw.x, margin, 1.0 - margin)) / 6.0, uvw.yz);
-    return textureLod(voxel_directional, packed_uvw, level);
-}
+#include "gi/sampling.glsl"
 
 // Voxel radiance at `uvw` for a cone travelling along `dir`, from the three directional
 // volumes facing the cone at mip `level`, weighted by the squared direction components
@@ -27,9 +14,10 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
 // of the three.
 vec4 sample_directional_volumes(vec3 uvw, vec3 dir, float level) {
     vec3 w = dir * dir;
-    vec4 sx = sample_directional(dir.x >= 0.0 ? 0 : 1, uvw, level);
-    vec4 sy = sample_directional(dir.y >= 0.0 ? 2 : 3, uvw, level);
-    vec4 sz = sample_directional(dir.z >= 0.0 ? 4 : 5, uvw, level);
+    vec4 sx;
+    vec4 sy;
+    vec4 sz;
+    sample_facing(uvw, dir, level, sx, sy, sz);
     vec4 mean = w.x * sx + w.y * sy + w.z * sz;
     vec3 transmittance = 1.0 - clamp(vec3(sx.a, sy.a, sz.a), 0.0, 0.9999);
     float alpha = 1.0 - exp2(dot(w, log2(transmittance)));
@@ -39,7 +27,7 @@ vec4 sample_directional_volumes(vec3 uvw, vec3 dir, float level) {
 // Voxel radiance at `uvw` for a cone travelling along `dir` with footprint `lod` (0 = one
 // voxel): the base level below lod 1, blended into the directional volumes above.
 vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
-    vec4 base = textureLod(voxel_radiance, uvw, 0.0);
+    vec4 base = sample_base(uvw);
     if (lod <= 0.0) {
         return base;
     }

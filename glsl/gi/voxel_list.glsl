@@ -1,30 +1,59 @@
-// The occupied-voxel list (compact.comp builds it; inject and bounce run over it, one
-// invocation per entry, dispatched indirectly from its head).
+// The occupied-voxel list (dense: compact.comp; octree: svo/bricks/compact.comp), one
+// invocation per entry of the passes that run over it, dispatched indirectly from its
+// head. An entry gives the voxel and where its values live: in the dense grid at the
+// voxel itself; in the octree in its leaf's bricks.
 #ifndef VOXEL_LIST_GLSL
 #define VOXEL_LIST_GLSL
 #include "gpu_layout.glsl"
+#ifdef VOXELS_SVO
+#include "svo/octree.glsl"
+#endif
 
 #ifndef VOXEL_LIST_WRITER
 readonly
 #endif
 layout(set = SET_PASS, binding = BINDING_GI_VOXEL_LIST, std430) buffer VoxelListBlock {
     VoxelListHeader list;
+    // Dense: the voxel (x | y << 10 | z << 20). Octree: the voxel, then its leaf's brick.
     uint list_voxels[];
 };
+
+#ifdef VOXELS_SVO
+#define VOXEL_LIST_STRIDE 2u
+#else
+#define VOXEL_LIST_STRIDE 1u
+#endif
 
 uint pack_voxel(ivec3 v) {
     return uint(v.x) | (uint(v.y) << 10) | (uint(v.z) << 20);
 }
 
+struct ListedVoxel {
+    // In the effective grid.
+    ivec3 voxel;
+    // Of its albedo, normal, emission and direct light.
+    ivec3 texel;
+    // Of its radiance.
+    ivec3 radiance_texel;
+};
+
 // The voxel of this invocation's entry; false past the end of the list.
-bool listed_voxel(out ivec3 voxel) {
+bool listed_voxel(out ListedVoxel entry) {
     uint index = gl_GlobalInvocationID.x;
     if (index >= list.count) {
-        voxel = ivec3(0);
         return false;
     }
-    uint v = list_voxels[index];
-    voxel = ivec3(v & 0x3ffu, (v >> 10) & 0x3ffu, v >> 20);
+    uint v = list_voxels[VOXEL_LIST_STRIDE * index];
+    entry.voxel = ivec3(v & 0x3ffu, (v >> 10) & 0x3ffu, v >> 20);
+#ifdef VOXELS_SVO
+    uint brick = list_voxels[VOXEL_LIST_STRIDE * index + 1u];
+    ivec3 within = entry.voxel & 1;
+    entry.texel = brick_origin(brick, counters.leaf_pool_side, SVO_ATTRIBUTE_BRICK) + within;
+    entry.radiance_texel = brick_origin(brick, counters.leaf_pool_side, SVO_RADIANCE_BRICK) + 1 + within;
+#else
+    entry.texel = entry.voxel;
+    entry.radiance_texel = entry.voxel;
+#endif
     return true;
 }
 #endif

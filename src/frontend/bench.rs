@@ -123,13 +123,15 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
     let mut stats_map = BTreeMap::new();
     let mut build_passes = Vec::new();
     stats_map.insert("triangles".to_string(), triangles as f64);
-    if let Some(gi) = renderer.dense_gi() {
-        let albedo = gi.download(crate::gi::Volume::Albedo, 0)?;
-        let occupied = albedo.chunks_exact(4).filter(|t| t[3] > 0).count();
+    if let Some(gi) = renderer.gi() {
         stats_map.insert("voxels".to_string(), f64::from(gi.grid.resolution));
-        stats_map.insert("occupied_voxels".to_string(), occupied as f64);
+        if gi.octree().is_none() {
+            let albedo = gi.download(crate::gi::Volume::Albedo, 0)?;
+            let occupied = albedo.chunks_exact(4).filter(|t| t[3] > 0).count();
+            stats_map.insert("occupied_voxels".to_string(), occupied as f64);
+        }
     }
-    if let Some(svo) = renderer.svo() {
+    if let Some(svo) = renderer.gi().and_then(|gi| gi.octree()) {
         let build = svo.report().context("the octree was not built")?;
         stats_map.insert("octree_depth".to_string(), f64::from(svo.depth));
         stats_map.extend(build.stats(&svo.capacities()));

@@ -35,18 +35,6 @@ pub fn load_scene(common: &CommonArgs) -> Result<Scene> {
 }
 
 /// Fails if the validation layer reported anything.
-/// `render` and `view` need the cone-traced image, which the sparse voxel octree cannot
-/// give yet.
-pub fn refuse_svo(settings: &crate::renderer::RenderSettings) -> Result<()> {
-    if settings.svo.is_some() {
-        bail!(
-            "--gi svo: the sparse voxel octree is built (see `voxcone bench --gi svo`) but its \
-             cone tracing is not written yet; use --gi dense to render"
-        );
-    }
-    Ok(())
-}
-
 pub fn check_validation(ctx: &Context) -> Result<()> {
     let count = ctx.validation_messages();
     if count > 0 {

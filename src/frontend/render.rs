@@ -38,7 +38,6 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
     let ctx = create_context(&args.common, Vec::new())?;
     let scene = load_scene(&args.common)?;
     let settings = args.common.render_settings(&scene.gi)?;
-    crate::frontend::refuse_svo(&settings)?;
     let extent = vk::Extent2D {
         width: args.size.0,
         height: args.size.1,

@@ -120,7 +120,6 @@ impl Viewer {
         let swapchain = Swapchain::new(&ctx, surface, extent)?;
         let scene = load_scene(&args.common)?;
         let settings = args.common.render_settings(&scene.gi)?;
-        crate::frontend::refuse_svo(&settings)?;
         let bounds = scene.bounds(0.0);
         let scene_size = (bounds.max - bounds.min).length().max(1e-3);
         let renderer = Renderer::new(&ctx, scene, settings, swapchain.extent, swapchain.format)?;
@@ -298,7 +297,7 @@ impl Viewer {
     fn switch(&mut self, code: KeyCode) -> Option<String> {
         let renderer = &mut self.renderer;
         if code == KeyCode::KeyG {
-            if renderer.dense_gi().is_none() {
+            if renderer.gi().is_none() {
                 return Some("no indirect light: start with --gi dense to have it".into());
             }
             let on = renderer.toggle_indirect();

@@ -15,22 +15,27 @@ pub struct ConeTracePass {
 }
 
 impl ConeTracePass {
-    /// `set_layouts` are those of sets 0, 1 and 2.
-    pub fn new(ctx: &Arc<Context>, set_layouts: [vk::DescriptorSetLayout; 3]) -> Result<Self> {
-        let pipeline = Pipeline::compute(
-            ctx,
-            "cone_trace",
-            crate::vk::shaders::GI_CONE_TRACE_CONE_TRACE_COMP,
-            &set_layouts,
-            0,
-        )?;
-        let upsample = Pipeline::compute(
-            ctx,
-            "upsample",
-            crate::vk::shaders::GI_CONE_TRACE_UPSAMPLE_COMP,
-            &set_layouts,
-            0,
-        )?;
+    /// `set_layouts` are those of sets 0, 1 and 2; `octree` picks the variants that
+    /// sample the octree's bricks.
+    pub fn new(
+        ctx: &Arc<Context>,
+        set_layouts: [vk::DescriptorSetLayout; 3],
+        octree: bool,
+    ) -> Result<Self> {
+        use crate::vk::shaders as s;
+        let (trace, upsample) = if octree {
+            (
+                s::GI_CONE_TRACE_CONE_TRACE_COMP_VOXELS_SVO,
+                s::GI_CONE_TRACE_UPSAMPLE_COMP_VOXELS_SVO,
+            )
+        } else {
+            (
+                s::GI_CONE_TRACE_CONE_TRACE_COMP,
+                s::GI_CONE_TRACE_UPSAMPLE_COMP,
+            )
+        };
+        let pipeline = Pipeline::compute(ctx, "cone_trace", trace, &set_layouts, 0)?;
+        let upsample = Pipeline::compute(ctx, "upsample", upsample, &set_layouts, 0)?;
         Ok(Self { pipeline, upsample })
     }
 

@@ -14,22 +14,24 @@ pub struct InjectPass {
 }
 
 impl InjectPass {
-    /// `set_layouts` are those of sets 0, 1 and 2.
-    pub fn new(ctx: &Arc<Context>, set_layouts: [vk::DescriptorSetLayout; 3]) -> Result<Self> {
-        let pipeline = Pipeline::compute(
-            ctx,
-            "inject",
-            crate::vk::shaders::GI_INJECT_INJECT_COMP,
-            &set_layouts,
-            0,
-        )?;
-        let bounce = Pipeline::compute(
-            ctx,
-            "bounce",
-            crate::vk::shaders::GI_INJECT_BOUNCE_COMP,
-            &set_layouts,
-            0,
-        )?;
+    /// `set_layouts` are those of sets 0, 1 and 2; `octree` picks the variants that
+    /// shade the octree's leaf voxels.
+    pub fn new(
+        ctx: &Arc<Context>,
+        set_layouts: [vk::DescriptorSetLayout; 3],
+        octree: bool,
+    ) -> Result<Self> {
+        use crate::vk::shaders as s;
+        let (inject, bounce) = if octree {
+            (
+                s::GI_INJECT_INJECT_COMP_VOXELS_SVO,
+                s::GI_INJECT_BOUNCE_COMP_VOXELS_SVO,
+            )
+        } else {
+            (s::GI_INJECT_INJECT_COMP, s::GI_INJECT_BOUNCE_COMP)
+        };
+        let pipeline = Pipeline::compute(ctx, "inject", inject, &set_layouts, 0)?;
+        let bounce = Pipeline::compute(ctx, "bounce", bounce, &set_layouts, 0)?;
         Ok(Self { pipeline, bounce })
     }
 

@@ -23,8 +23,10 @@ use glam::Vec3;
 
 use crate::gbuffer::GBuffer;
 use crate::gpu_layout::{self as layout, GiUniforms};
+use crate::renderer::GiSettings;
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
+use crate::svo::{Capacities, SvoGi};
 use crate::vk::{
     clear_to_zero, image_barrier, memory_barrier, read_back_image, sampler_info, Binding, Buffer,
     Context, DescriptorSets, GpuTimer, Image, ImageDesc, ImageUse, OneShot, Sampler, SetWriter,
@@ -346,29 +348,53 @@ pub(crate) fn compute_to_compute(ctx: &Context, cmd: vk::CommandBuffer) {
     );
 }
 
-pub struct DenseGi {
-    pub grid: Grid,
+/// Which structure holds the voxels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum VoxelStructure {
+    /// A dense grid in 3D textures.
+    Dense,
+    /// A sparse voxel octree (`crate::svo`) of the same effective resolution.
+    Octree {
+        /// Pool sizes to start from instead of the estimate from the scene.
+        capacities: Option<Capacities>,
+    },
+}
+
+/// The dense grid's volumes and the passes that fill them.
+struct Dense {
     volumes: Volumes,
     voxelize: voxelize::VoxelizePass,
+    compact: compact::CompactPass,
+    filter: filter::FilterPass,
+    voxel_view: debug::VoxelViewPass,
+    /// Re-voxelize everything every frame.
+    full_update: bool,
+    /// The static meshes are in the voxels (or in `Volumes::static_packed`).
+    static_ready: bool,
+}
+
+enum Voxels {
+    Dense(Box<Dense>),
+    Octree(Box<SvoGi>),
+}
+
+/// Voxel cone tracing: the voxels (a dense grid or an octree), their shading and
+/// filtering, and the cones gathered per pixel.
+pub struct VoxelGi {
+    pub grid: Grid,
+    voxels: Voxels,
     inject: inject::InjectPass,
     bounces: u32,
     accumulate_bounces: bool,
     /// The directional volumes hold last frame's result (with its bounces).
     history: bool,
-    /// Re-voxelize everything every frame.
-    full_update: bool,
-    /// The static meshes are in the voxels (or in `Volumes::static_packed`).
-    static_ready: bool,
     /// `ConeSettings::indirect_scale`.
     indirect_scale_setting: Option<u32>,
     /// The scale of the current screen targets.
     indirect_scale: u32,
     /// Created with the screen targets.
     low_res: Option<LowRes>,
-    filter: filter::FilterPass,
     cone_trace: cone_trace::ConeTracePass,
-    voxel_view: debug::VoxelViewPass,
-    compact: compact::CompactPass,
     set: vk::DescriptorSet,
     _sets: DescriptorSets,
     uniforms: Buffer,
@@ -377,62 +403,20 @@ pub struct DenseGi {
     ctx: Arc<Context>,
 }
 
-impl DenseGi {
-    /// `set_layouts` are those of sets 0 and 1.
-    pub fn new(
+impl Dense {
+    /// `layouts` are those of sets 0, 1 and 2; writes the volumes into `set`.
+    fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
         resolution: u32,
-        cones: ConeSettings,
         full_update: bool,
-        set_layouts: [vk::DescriptorSetLayout; 2],
+        set: vk::DescriptorSet,
+        layouts: [vk::DescriptorSetLayout; 3],
+        linear: vk::Sampler,
     ) -> Result<Self> {
-        check_voxels(resolution)?;
-        if !ctx.features.geometry_shader || !ctx.features.fragment_stores_and_atomics {
-            bail!(
-                "--gi dense needs geometry shaders and fragment stores/atomics, which {} lacks",
-                ctx.device_name()
-            );
-        }
-        let grid = Grid::around(scene, resolution);
         let moving_meshes = scene.meshes.iter().any(|m| m.animation.is_some());
         let volumes = Volumes::new(ctx, resolution, moving_meshes && !full_update)?;
-        let emission_range = emission_range(scene);
-        let uniforms = GiUniforms {
-            origin: grid.origin.extend(grid.voxel_size).to_array(),
-            resolution,
-            directional_levels: resolution.trailing_zeros(),
-            emission_range,
-            step_factor: cones.step_factor,
-            diffuse_tan_half: (cones.diffuse_aperture_deg.to_radians() * 0.5).tan(),
-            max_distance: grid.voxel_size * resolution as f32 * 1.8,
-            indirect_scale: 0,
-            diffuse_cones: cones.diffuse_cones.clamp(1, 16),
-            shadow_tan_half: (cones.shadow_aperture_deg.to_radians() * 0.5).tan(),
-            ao_distance: cones.ao_distance_voxels.max(1e-3) * grid.voxel_size,
-            ..Default::default()
-        };
-        let uniforms = Buffer::with_data(
-            ctx,
-            "gi uniforms",
-            bytemuck::bytes_of(&uniforms),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-        )?;
-        let sets = DescriptorSets::new(ctx, "gi", &gi_bindings(), 1)?;
-        let set = sets.allocate("gi")?;
-        let linear = Sampler::new(
-            ctx,
-            "voxel linear",
-            // Not a transparent border: at coarse levels the grid is a few texels across,
-            // and filtering towards a border would thin every wall there.
-            &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::CLAMP_TO_EDGE),
-        )?;
         SetWriter::new(ctx, set)
-            .buffer(
-                layout::BINDING_GI_UNIFORMS,
-                vk::DescriptorType::UNIFORM_BUFFER,
-                uniforms.raw,
-            )
             .storage_image(layout::BINDING_GI_ALBEDO, volumes.albedo.view)
             .storage_image(layout::BINDING_GI_NORMAL, volumes.normal.view)
             .storage_image(layout::BINDING_GI_EMISSION, volumes.emission.view)
@@ -441,13 +425,13 @@ impl DenseGi {
             .sampled_image(
                 layout::BINDING_GI_RADIANCE_SAMPLED,
                 volumes.radiance.view,
-                linear.raw,
+                linear,
                 vk::ImageLayout::GENERAL,
             )
             .sampled_image(
                 layout::BINDING_GI_DIRECTIONAL,
                 volumes.directional.view,
-                linear.raw,
+                linear,
                 vk::ImageLayout::GENERAL,
             )
             .apply();
@@ -465,12 +449,7 @@ impl DenseGi {
             }
             Ok(())
         })?;
-        let gi_layout = sets.layout;
-        let compact = compact::CompactPass::new(
-            ctx,
-            [set_layouts[0], set_layouts[1], gi_layout],
-            resolution,
-        )?;
+        let compact = compact::CompactPass::new(ctx, layouts, resolution)?;
         SetWriter::new(ctx, set)
             .buffer(
                 layout::BINDING_GI_VOXEL_LIST,
@@ -479,39 +458,305 @@ impl DenseGi {
             )
             .apply();
         Ok(Self {
-            grid,
             voxelize: voxelize::VoxelizePass::new(
                 ctx,
                 "voxelize",
                 crate::vk::shaders::GI_VOXELIZE_VOXELIZE_FRAG,
-                [set_layouts[0], set_layouts[1], gi_layout],
+                layouts,
             )?,
-            inject: inject::InjectPass::new(ctx, [set_layouts[0], set_layouts[1], gi_layout])?,
+            filter: filter::FilterPass::new(ctx, [layouts[0], layouts[1]], &volumes)?,
+            voxel_view: debug::VoxelViewPass::new(ctx, layouts)?,
+            compact,
+            volumes,
+            full_update,
+            static_ready: false,
+        })
+    }
+
+    /// Voxelizes what this frame needs (the moving meshes, or everything the first time
+    /// or with `full_update`) into `set`'s volumes and lists the occupied voxels.
+    fn record_voxelize(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
+        draw: &SceneDraw,
+        set: vk::DescriptorSet,
+        n: u32,
+    ) {
+        let voxelized =
+            self.full_update || !self.static_ready || self.volumes.static_packed.is_some();
+        if self.full_update || !self.static_ready {
+            timer.begin(cmd, "voxelize");
+            for image in self.volumes.packed() {
+                // Last frame's injection read these.
+                clear_to_zero(
+                    ctx,
+                    cmd,
+                    image,
+                    PACKED_AFTER_INJECT,
+                    voxelize::VoxelizePass::IMAGE_USE,
+                );
+            }
+            if self.full_update {
+                self.voxelize
+                    .record(ctx, cmd, draw, set, n, voxelize::Meshes::All);
+            } else {
+                self.voxelize
+                    .record(ctx, cmd, draw, set, n, voxelize::Meshes::Static);
+                if let Some(copies) = &self.volumes.static_packed {
+                    for (image, copy) in self.volumes.packed().into_iter().zip(copies) {
+                        self.copy_packed(ctx, cmd, image, copy, ImageUse::UNDEFINED, true);
+                    }
+                    self.voxelize
+                        .record(ctx, cmd, draw, set, n, voxelize::Meshes::Moving);
+                }
+                self.static_ready = true;
+            }
+            timer.end(cmd);
+        } else if let Some(copies) = &self.volumes.static_packed {
+            // The moving meshes start again from the static voxels; the static meshes are
+            // not drawn.
+            timer.begin(cmd, "voxelize");
+            for (image, copy) in self.volumes.packed().into_iter().zip(copies) {
+                self.copy_packed(ctx, cmd, copy, image, ImageUse::TRANSFER_SRC, false);
+            }
+            self.voxelize
+                .record(ctx, cmd, draw, set, n, voxelize::Meshes::Moving);
+            timer.end(cmd);
+        }
+        if voxelized {
+            timer.begin(cmd, "compact");
+            memory_barrier(
+                ctx,
+                cmd,
+                (
+                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_READ,
+                ),
+            );
+            self.compact.record(ctx, cmd, draw.frame_set, set, n);
+            // Injection writes only the listed voxels: the others must read zero.
+            for image in [&self.volumes.radiance, &self.volumes.direct] {
+                clear_to_zero(ctx, cmd, image, RADIANCE_USE, RADIANCE_USE);
+            }
+            timer.end(cmd);
+        }
+    }
+
+    /// Copies packed volume `from` to `to`. `from_working` says which one is the working
+    /// volume (voxelized just before; otherwise it is overwritten after last frame's
+    /// injection). The static copies stay in TRANSFER_SRC layout between frames;
+    /// `to_before` is the state of `to` when it is a static copy.
+    fn copy_packed(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        from: &Image,
+        to: &Image,
+        to_before: ImageUse,
+        from_working: bool,
+    ) {
+        let range = from.full_range();
+        let (from_before, to_before) = if from_working {
+            (voxelize::VoxelizePass::IMAGE_USE, to_before)
+        } else {
+            (
+                ImageUse::TRANSFER_SRC,
+                ImageUse::discard_after(PACKED_AFTER_INJECT),
+            )
+        };
+        image_barrier(
+            ctx,
+            cmd,
+            from.raw,
+            range,
+            from_before,
+            ImageUse::TRANSFER_SRC,
+        );
+        image_barrier(ctx, cmd, to.raw, range, to_before, ImageUse::TRANSFER_DST);
+        let layers = vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        };
+        let region = vk::ImageCopy {
+            src_subresource: layers,
+            src_offset: vk::Offset3D::default(),
+            dst_subresource: layers,
+            dst_offset: vk::Offset3D::default(),
+            extent: from.desc.extent,
+        };
+        unsafe {
+            ctx.device.cmd_copy_image(
+                cmd,
+                from.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                to.raw,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            )
+        };
+        let (working, copy) = if from_working { (from, to) } else { (to, from) };
+        let working_before = if from_working {
+            ImageUse::TRANSFER_SRC
+        } else {
+            ImageUse::TRANSFER_DST
+        };
+        image_barrier(
+            ctx,
+            cmd,
+            working.raw,
+            range,
+            working_before,
+            voxelize::VoxelizePass::IMAGE_USE,
+        );
+        if from_working {
+            // The static copy keeps TRANSFER_SRC for the next frames' copies.
+            image_barrier(
+                ctx,
+                cmd,
+                copy.raw,
+                range,
+                ImageUse::TRANSFER_DST,
+                ImageUse::TRANSFER_SRC,
+            );
+        }
+    }
+}
+
+impl VoxelGi {
+    /// `set_layouts` are those of sets 0 and 1.
+    pub fn new(
+        ctx: &Arc<Context>,
+        scene: &Scene,
+        settings: &GiSettings,
+        set_layouts: [vk::DescriptorSetLayout; 2],
+    ) -> Result<Self> {
+        let resolution = settings.voxels;
+        let cones = settings.cones;
+        check_voxels(resolution)?;
+        if !ctx.features.geometry_shader || !ctx.features.fragment_stores_and_atomics {
+            bail!(
+                "voxel GI needs geometry shaders and fragment stores/atomics, which {} lacks",
+                ctx.device_name()
+            );
+        }
+        let grid = Grid::around(scene, resolution);
+        let uniforms = GiUniforms {
+            origin: grid.origin.extend(grid.voxel_size).to_array(),
+            resolution,
+            directional_levels: resolution.trailing_zeros(),
+            emission_range: emission_range(scene),
+            step_factor: cones.step_factor,
+            diffuse_tan_half: (cones.diffuse_aperture_deg.to_radians() * 0.5).tan(),
+            max_distance: grid.voxel_size * resolution as f32 * 1.8,
+            indirect_scale: 0,
+            diffuse_cones: cones.diffuse_cones.clamp(1, 16),
+            shadow_tan_half: (cones.shadow_aperture_deg.to_radians() * 0.5).tan(),
+            ao_distance: cones.ao_distance_voxels.max(1e-3) * grid.voxel_size,
+            ..Default::default()
+        };
+        let uniforms = Buffer::with_data(
+            ctx,
+            "gi uniforms",
+            bytemuck::bytes_of(&uniforms),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let mut bindings = gi_bindings();
+        bindings.extend(crate::svo::bindings());
+        let sets = DescriptorSets::new(ctx, "gi", &bindings, 1)?;
+        let set = sets.allocate("gi")?;
+        SetWriter::new(ctx, set)
+            .buffer(
+                layout::BINDING_GI_UNIFORMS,
+                vk::DescriptorType::UNIFORM_BUFFER,
+                uniforms.raw,
+            )
+            .apply();
+        let linear = Sampler::new(
+            ctx,
+            "voxel linear",
+            // Not a transparent border: at coarse levels the grid is a few texels across,
+            // and filtering towards a border would thin every wall there.
+            &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::CLAMP_TO_EDGE),
+        )?;
+        let layouts = [set_layouts[0], set_layouts[1], sets.layout];
+        let octree = !matches!(settings.structure, VoxelStructure::Dense);
+        let voxels = match settings.structure {
+            VoxelStructure::Dense => Voxels::Dense(Box::new(Dense::new(
+                ctx,
+                scene,
+                resolution,
+                settings.full_update,
+                set,
+                layouts,
+                linear.raw,
+            )?)),
+            VoxelStructure::Octree { capacities } => {
+                if scene.is_animated() || settings.full_update {
+                    bail!(
+                        "--gi svo builds the octree once: moving meshes and --full-update \
+                         need --gi dense for now"
+                    );
+                }
+                Voxels::Octree(Box::new(SvoGi::new(
+                    ctx,
+                    scene,
+                    resolution.trailing_zeros(),
+                    capacities,
+                    layouts,
+                    set,
+                    linear.raw,
+                )?))
+            }
+        };
+        Ok(Self {
+            grid,
+            voxels,
+            inject: inject::InjectPass::new(ctx, layouts, octree)?,
             bounces: cones.bounces.max(1),
             accumulate_bounces: cones.accumulate_bounces && cones.bounces > 1,
             history: false,
-            full_update,
-            static_ready: false,
             indirect_scale_setting: cones.indirect_scale,
             indirect_scale: 1,
             low_res: None,
-            filter: filter::FilterPass::new(ctx, set_layouts, &volumes)?,
-            cone_trace: cone_trace::ConeTracePass::new(
-                ctx,
-                [set_layouts[0], set_layouts[1], gi_layout],
-            )?,
-            voxel_view: debug::VoxelViewPass::new(
-                ctx,
-                [set_layouts[0], set_layouts[1], gi_layout],
-            )?,
-            compact,
-            volumes,
+            cone_trace: cone_trace::ConeTracePass::new(ctx, layouts, octree)?,
             set,
             _sets: sets,
             uniforms,
             _linear: linear,
             ctx: ctx.clone(),
         })
+    }
+
+    /// Work before the first frame: the octree's build (waited for; its pools grow and it
+    /// runs again if they overflow).
+    pub fn prepare(&mut self, draw: &SceneDraw) -> Result<()> {
+        if let Voxels::Octree(svo) = &mut self.voxels {
+            svo.build(draw, self.set)?;
+        }
+        Ok(())
+    }
+
+    /// The octree, with `--gi svo`.
+    pub fn octree(&self) -> Option<&SvoGi> {
+        match &self.voxels {
+            Voxels::Octree(svo) => Some(svo),
+            Voxels::Dense(_) => None,
+        }
+    }
+
+    fn dense(&self) -> Result<&Dense> {
+        match &self.voxels {
+            Voxels::Dense(dense) => Ok(dense),
+            Voxels::Octree(_) => bail!("the voxels are in an octree, not in dense volumes"),
+        }
     }
 
     /// Points the cone tracer at new screen targets; no frame using the old ones may be
@@ -589,11 +834,16 @@ impl DenseGi {
         self.history = false;
     }
 
-    /// GPU memory of every voxel volume and the voxel list, by name.
+    /// GPU memory of every voxel volume (or octree pool) and the voxel list, by name.
     pub fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
-        let mut bytes = self.volumes.bytes();
-        bytes.push(("voxel_list", self.compact.list.size));
-        bytes
+        match &self.voxels {
+            Voxels::Dense(dense) => {
+                let mut bytes = dense.volumes.bytes();
+                bytes.push(("voxel_list", dense.compact.list.size));
+                bytes
+            }
+            Voxels::Octree(svo) => svo.memory_bytes(),
+        }
     }
 
     /// Voxelizes the scene and lights and filters the voxels (after the shadow maps).
@@ -609,68 +859,15 @@ impl DenseGi {
     ) {
         let ctx = &self.ctx;
         let n = self.grid.resolution;
-        let voxelized =
-            self.full_update || !self.static_ready || self.volumes.static_packed.is_some();
-        if self.full_update || !self.static_ready {
-            timer.begin(cmd, "voxelize");
-            for image in self.volumes.packed() {
-                // Last frame's injection read these.
-                clear_to_zero(
-                    ctx,
-                    cmd,
-                    image,
-                    PACKED_AFTER_INJECT,
-                    voxelize::VoxelizePass::IMAGE_USE,
-                );
+        let set = self.set;
+        let list = match &mut self.voxels {
+            Voxels::Dense(dense) => {
+                dense.record_voxelize(ctx, cmd, timer, draw, set, n);
+                dense.compact.list.raw
             }
-            if self.full_update {
-                self.voxelize
-                    .record(ctx, cmd, draw, self.set, n, voxelize::Meshes::All);
-            } else {
-                self.voxelize
-                    .record(ctx, cmd, draw, self.set, n, voxelize::Meshes::Static);
-                if let Some(copies) = &self.volumes.static_packed {
-                    for (image, copy) in self.volumes.packed().into_iter().zip(copies) {
-                        self.copy_packed(cmd, image, copy, ImageUse::UNDEFINED, true);
-                    }
-                    self.voxelize
-                        .record(ctx, cmd, draw, self.set, n, voxelize::Meshes::Moving);
-                }
-                self.static_ready = true;
-            }
-            timer.end(cmd);
-        } else if let Some(copies) = &self.volumes.static_packed {
-            // The moving meshes start again from the static voxels; the static meshes are
-            // not drawn.
-            timer.begin(cmd, "voxelize");
-            for (image, copy) in self.volumes.packed().into_iter().zip(copies) {
-                self.copy_packed(cmd, copy, image, ImageUse::TRANSFER_SRC, false);
-            }
-            self.voxelize
-                .record(ctx, cmd, draw, self.set, n, voxelize::Meshes::Moving);
-            timer.end(cmd);
-        }
-        if voxelized {
-            timer.begin(cmd, "compact");
-            memory_barrier(
-                ctx,
-                cmd,
-                (
-                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                ),
-                (
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    vk::AccessFlags2::SHADER_STORAGE_READ,
-                ),
-            );
-            self.compact.record(ctx, cmd, draw.frame_set, self.set, n);
-            // Injection writes only the listed voxels: the others must read zero.
-            for image in [&self.volumes.radiance, &self.volumes.direct] {
-                clear_to_zero(ctx, cmd, image, RADIANCE_USE, RADIANCE_USE);
-            }
-            timer.end(cmd);
-        }
+            // Built before the first frame.
+            Voxels::Octree(svo) => svo.voxel_list(),
+        };
 
         timer.begin(cmd, "inject");
         memory_barrier(
@@ -687,107 +884,28 @@ impl DenseGi {
         );
         // Last frame's cone tracing sampled the radiance volumes that are rewritten now.
         compute_to_compute(ctx, cmd);
-        self.inject
-            .record(cmd, draw.frame_set, self.set, self.compact.list.raw);
+        self.inject.record(cmd, draw.frame_set, set, list);
         timer.end(cmd);
 
+        let filter = |voxels: &Voxels| match voxels {
+            Voxels::Dense(dense) => dense.filter.record(ctx, cmd, n),
+            Voxels::Octree(svo) => svo.record_filter(cmd, draw.frame_set, set),
+        };
         let bounces = if self.history { 1 } else { self.bounces - 1 };
         if !self.history {
             timer.begin(cmd, "filter");
             compute_to_compute(ctx, cmd);
-            self.filter.record(ctx, cmd, n);
+            filter(&self.voxels);
             timer.end(cmd);
         }
         self.history = self.accumulate_bounces;
         for _ in 0..bounces {
             timer.begin(cmd, "bounce");
             compute_to_compute(ctx, cmd);
-            self.inject
-                .record_bounce(cmd, draw.frame_set, self.set, self.compact.list.raw);
+            self.inject.record_bounce(cmd, draw.frame_set, set, list);
             compute_to_compute(ctx, cmd);
-            self.filter.record(ctx, cmd, n);
+            filter(&self.voxels);
             timer.end(cmd);
-        }
-    }
-
-    /// Copies packed volume `from` to `to`. `from_working` says which one is the working
-    /// volume (voxelized just before; otherwise it is overwritten after last frame's
-    /// injection). The static copies stay in TRANSFER_SRC layout between frames;
-    /// `to_before` is the state of `to` when it is a static copy.
-    fn copy_packed(
-        &self,
-        cmd: vk::CommandBuffer,
-        from: &Image,
-        to: &Image,
-        to_before: ImageUse,
-        from_working: bool,
-    ) {
-        let ctx = &self.ctx;
-        let range = from.full_range();
-        let (from_before, to_before) = if from_working {
-            (voxelize::VoxelizePass::IMAGE_USE, to_before)
-        } else {
-            (
-                ImageUse::TRANSFER_SRC,
-                ImageUse::discard_after(PACKED_AFTER_INJECT),
-            )
-        };
-        image_barrier(
-            ctx,
-            cmd,
-            from.raw,
-            range,
-            from_before,
-            ImageUse::TRANSFER_SRC,
-        );
-        image_barrier(ctx, cmd, to.raw, range, to_before, ImageUse::TRANSFER_DST);
-        let layers = vk::ImageSubresourceLayers {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            mip_level: 0,
-            base_array_layer: 0,
-            layer_count: 1,
-        };
-        let region = vk::ImageCopy {
-            src_subresource: layers,
-            src_offset: vk::Offset3D::default(),
-            dst_subresource: layers,
-            dst_offset: vk::Offset3D::default(),
-            extent: from.desc.extent,
-        };
-        unsafe {
-            ctx.device.cmd_copy_image(
-                cmd,
-                from.raw,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                to.raw,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[region],
-            )
-        };
-        let (working, copy) = if from_working { (from, to) } else { (to, from) };
-        let working_before = if from_working {
-            ImageUse::TRANSFER_SRC
-        } else {
-            ImageUse::TRANSFER_DST
-        };
-        image_barrier(
-            ctx,
-            cmd,
-            working.raw,
-            range,
-            working_before,
-            voxelize::VoxelizePass::IMAGE_USE,
-        );
-        if from_working {
-            // The static copy keeps TRANSFER_SRC for the next frames' copies.
-            image_barrier(
-                ctx,
-                cmd,
-                copy.raw,
-                range,
-                ImageUse::TRANSFER_DST,
-                ImageUse::TRANSFER_SRC,
-            );
         }
     }
 
@@ -801,10 +919,10 @@ impl DenseGi {
         extent: vk::Extent2D,
         voxel_view: bool,
     ) {
-        if voxel_view {
+        if let (true, Voxels::Dense(dense)) = (voxel_view, &self.voxels) {
             timer.begin(cmd, "voxel_view");
             compute_to_compute(&self.ctx, cmd);
-            self.voxel_view.record(cmd, frame_set, self.set, extent);
+            dense.voxel_view.record(cmd, frame_set, self.set, extent);
             timer.end(cmd);
             return;
         }
@@ -829,7 +947,7 @@ impl DenseGi {
     /// frames that build it are done.
     #[cfg(test)]
     pub fn download_voxel_list(&self) -> Result<Vec<[u32; 3]>> {
-        let bytes = crate::vk::read_back_buffer(&self.ctx, &self.compact.list)?;
+        let bytes = crate::vk::read_back_buffer(&self.ctx, &self.dense()?.compact.list)?;
         let words: &[u32] = bytemuck::cast_slice(&bytes);
         let header: layout::VoxelListHeader =
             bytemuck::pod_read_unaligned(bytemuck::cast_slice(&words[..4]));
@@ -849,7 +967,7 @@ impl DenseGi {
     /// Downloads one level of a volume, texel after texel (x fastest), once the frames
     /// that write it are done: the check of each stage against its CPU twin reads it.
     pub fn download(&self, volume: Volume, level: u32) -> Result<Vec<u8>> {
-        let v = &self.volumes;
+        let v = &self.dense()?.volumes;
         let image = match volume {
             Volume::Albedo => &v.albedo,
             Volume::Normal => &v.normal,
@@ -891,7 +1009,7 @@ impl DenseGi {
     }
 }
 
-/// A voxel volume, for [`DenseGi::download`].
+/// A voxel volume, for [`VoxelGi::download`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Volume {
     /// Packed RGBA8 albedo; alpha counts the fragments (0 = empty voxel).

@@ -27,6 +27,7 @@ fn render_at(scene: Scene, n: u32, times: &[f32], full_update: bool) -> (Arc<Con
     let settings = RenderSettings {
         gi: Some(GiSettings {
             voxels: n,
+            structure: super::VoxelStructure::Dense,
             cones: Default::default(),
             shadow_cones: false,
             full_update,
@@ -69,11 +70,7 @@ fn render(scene: Scene, n: u32) -> (Arc<Context>, Renderer) {
 }
 
 fn occupancy(renderer: &Renderer) -> Vec<bool> {
-    let bytes = renderer
-        .dense_gi()
-        .unwrap()
-        .download(Volume::Albedo, 0)
-        .unwrap();
+    let bytes = renderer.gi().unwrap().download(Volume::Albedo, 0).unwrap();
     bytes.chunks_exact(4).map(|t| t[3] > 0).collect()
 }
 
@@ -82,7 +79,7 @@ fn occupancy(renderer: &Renderer) -> Vec<bool> {
 fn check_voxelization(scene: Scene, n: u32) {
     let triangles = reference::world_triangles(&scene);
     let (ctx, renderer) = render(scene, n);
-    let grid: Grid = renderer.dense_gi().unwrap().grid;
+    let grid: Grid = renderer.gi().unwrap().grid;
     let gpu = occupancy(&renderer);
     let exact = reference::voxelize(&triangles, &grid);
     let near = reference::within_one_voxel(&triangles, &grid);
@@ -153,7 +150,7 @@ fn filter_matches_cpu() {
     let options = LoadOptions::REFERENCE;
     let n = 32;
     let (ctx, renderer) = render(Scene::load(&path, &options).unwrap(), n);
-    let gi = renderer.dense_gi().unwrap();
+    let gi = renderer.gi().unwrap();
     let base = halves(&gi.download(Volume::Radiance, 0).unwrap());
     let normals: Vec<Vec3> = gi
         .download(Volume::Normal, 0)
@@ -233,7 +230,7 @@ fn moving_mesh_leaves_no_voxels_behind() {
         moved_voxels, fresh_voxels,
         "voxels left behind or missing after the move"
     );
-    let albedo = |r: &Renderer| r.dense_gi().unwrap().download(Volume::Albedo, 0).unwrap();
+    let albedo = |r: &Renderer| r.gi().unwrap().download(Volume::Albedo, 0).unwrap();
     assert!(
         albedo(&moved) == albedo(&fresh),
         "albedo differs from a fresh voxelization"
@@ -281,7 +278,7 @@ fn voxel_list_holds_exactly_the_occupied_voxels() {
     let scene = Scene::load(&path, &LoadOptions::default()).unwrap();
     let n = 32;
     let (ctx, renderer) = render_at(scene, n, &[0.0, 0.5], true);
-    let gi = renderer.dense_gi().unwrap();
+    let gi = renderer.gi().unwrap();
     let occupied = occupancy(&renderer);
     let mut listed = vec![false; occupied.len()];
     for [x, y, z] in gi.download_voxel_list().unwrap() {

@@ -1,43 +1,100 @@
-//! Leaf bricks from the voxel fragments (`glsl/svo/bricks/fill.comp`): each fragment adds
-//! its attributes to its voxel in its leaf's brick, as RGBA8 moving averages.
+//! The bricks (`glsl/svo/bricks/`): leaf bricks filled from the voxel fragments
+//! (`fill.comp`), the list of occupied leaf voxels that voxel shading runs over
+//! (`compact.comp`), interior bricks filtered bottom-up (`filter.comp`) and every brick's
+//! border copied from its neighbours (`apron.comp`).
+//!
+//! A brick holds its node's 2x2x2 voxels at voxel centres, exactly as the dense grid holds
+//! them, so both paths read the same values and share their CPU references; the radiance
+//! bricks add a border of one voxel (4x4x4 texels) so that hardware trilinear filtering
+//! anywhere inside the node needs no other brick. Crassin's 3x3x3 bricks with values at
+//! node corners use fewer texels, but their samples sit at other places than the dense
+//! grid's, and the two paths could no longer be checked against each other voxel for
+//! voxel.
 
 use std::sync::Arc;
 
 use anyhow::Result;
 use ash::vk;
 
+use super::octree::level_offset;
+use crate::gi::compute_to_compute;
+use crate::gpu_layout::SvoPush;
 use crate::vk::{Context, Pipeline};
 
-/// Leaf bricks hold the leaf's 2x2x2 voxels of the effective grid, with voxel values at
-/// voxel centres exactly as the dense grid holds them, so that the two paths sample the
-/// same values.
-pub const LEAF_BRICK_EDGE: u32 = 2;
-
-pub struct FillPass {
-    pipeline: Pipeline,
+pub struct BrickPasses {
+    fill: Pipeline,
+    list: Pipeline,
+    filter: Pipeline,
+    apron: Pipeline,
 }
 
-impl FillPass {
+impl BrickPasses {
     /// `set_layouts` are those of sets 0, 1 and 2.
     pub fn new(ctx: &Arc<Context>, set_layouts: [vk::DescriptorSetLayout; 3]) -> Result<Self> {
+        let push = std::mem::size_of::<SvoPush>() as u32;
+        let pipeline = |name, spirv| Pipeline::compute(ctx, name, spirv, &set_layouts, push);
+        use crate::vk::shaders as s;
         Ok(Self {
-            pipeline: Pipeline::compute(
-                ctx,
-                "svo fill",
-                crate::vk::shaders::SVO_BRICKS_FILL_COMP,
-                &set_layouts,
-                0,
-            )?,
+            fill: pipeline("svo fill", s::SVO_BRICKS_FILL_COMP)?,
+            list: pipeline("svo voxel list", s::SVO_BRICKS_COMPACT_COMP)?,
+            filter: pipeline("svo filter", s::SVO_BRICKS_FILTER_COMP)?,
+            apron: pipeline("svo apron", s::SVO_BRICKS_APRON_COMP)?,
         })
     }
 
     /// One invocation per stored fragment; `counters` holds the dispatch at its start.
-    pub fn record(
+    pub fn record_fill(
         &self,
         cmd: vk::CommandBuffer,
         sets: &[(u32, vk::DescriptorSet)],
         counters: vk::Buffer,
     ) {
-        self.pipeline.dispatch_indirect(cmd, sets, counters, 0);
+        self.fill.dispatch_indirect(cmd, sets, counters, 0);
+    }
+
+    /// Lists the occupied voxels of the leaves, at `leaf_level`.
+    pub fn record_list(
+        &self,
+        cmd: vk::CommandBuffer,
+        sets: &[(u32, vk::DescriptorSet)],
+        counters: vk::Buffer,
+        leaf_level: u32,
+    ) {
+        self.dispatch_level(&self.list, cmd, sets, counters, leaf_level);
+    }
+
+    /// Borders of the leaves, then each level above filtered from the one below and
+    /// given its borders, up to the root.
+    pub fn record_filter(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        sets: &[(u32, vk::DescriptorSet)],
+        counters: vk::Buffer,
+        depth: u32,
+    ) {
+        self.dispatch_level(&self.apron, cmd, sets, counters, depth - 1);
+        for level in (0..depth - 1).rev() {
+            compute_to_compute(ctx, cmd);
+            self.dispatch_level(&self.filter, cmd, sets, counters, level);
+            compute_to_compute(ctx, cmd);
+            self.dispatch_level(&self.apron, cmd, sets, counters, level);
+        }
+    }
+
+    fn dispatch_level(
+        &self,
+        pipeline: &Pipeline,
+        cmd: vk::CommandBuffer,
+        sets: &[(u32, vk::DescriptorSet)],
+        counters: vk::Buffer,
+        level: u32,
+    ) {
+        let push = SvoPush {
+            level,
+            ..Default::default()
+        };
+        pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
+        pipeline.dispatch_indirect(cmd, sets, counters, level_offset(level));
     }
 }

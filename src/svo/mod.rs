@@ -19,15 +19,14 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use crate::gi::voxelize::{Meshes, VoxelizePass};
-use crate::gi::{compute_to_compute, emission_range, Grid};
-use crate::gpu_layout::{self as layout, GiUniforms, SvoCounters, SvoLevel, VoxelFragment};
+use crate::gi::{compute_to_compute, Grid};
+use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel, VoxelFragment, VoxelListHeader};
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
-    clear_to_zero, copies_to_host_barrier, memory_barrier, Binding, Buffer, Context,
-    DescriptorSets, GpuTimer, Image, ImageDesc, ImageUse, OneShot, SetWriter,
+    clear_to_zero, copies_to_host_barrier, memory_barrier, Binding, Buffer, Context, GpuTimer,
+    Image, ImageDesc, ImageUse, OneShot, SetWriter,
 };
-use bricks::LEAF_BRICK_EDGE;
 
 /// Octree depths `--octree-depth` accepts: effective grids of 64³ to 1024³.
 pub const DEPTHS: std::ops::RangeInclusive<u32> = 6..=10;
@@ -177,15 +176,34 @@ struct Pools {
     neighbours: Buffer,
     leaf_side: u32,
     interior_side: u32,
-    /// Leaf-brick attributes: albedo, normal, emission.
+    /// Leaf-brick attributes: albedo, normal, emission (`SVO_ATTRIBUTE_BRICK`³ each).
     leaf_attributes: [Image; 3],
+    /// Leaf voxels' direct light, the start of each bounce (`SVO_ATTRIBUTE_BRICK`³ each).
+    leaf_direct: Image,
+    /// Leaf radiance (`SVO_RADIANCE_BRICK`³ each: the voxels and a border).
+    leaf_radiance: Image,
+    /// Interior bricks' six directional radiances, side by side along x.
+    directional: Image,
+    /// The occupied leaf voxels with their bricks (`VoxelListHeader`, then two words each).
+    voxel_list: Buffer,
 }
 
 const COUNTERS_BYTES: usize = std::mem::size_of::<SvoCounters>()
     + layout::SVO_MAX_LEVELS as usize * std::mem::size_of::<SvoLevel>();
 
+/// The radiance pools between passes: written as storage, sampled by cones.
+const RADIANCE_USE: ImageUse = ImageUse {
+    layout: vk::ImageLayout::GENERAL,
+    stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+    access: vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::SHADER_READ.as_raw() | vk::AccessFlags2::SHADER_WRITE.as_raw(),
+    ),
+};
+
 impl Pools {
-    fn new(ctx: &Arc<Context>, capacities: Capacities, device_limit: u64) -> Result<Self> {
+    fn new(ctx: &Arc<Context>, capacities: Capacities) -> Result<Self> {
+        let device_limit = u64::from(ctx.properties.limits.max_storage_buffer_range);
+        let max_3d = ctx.properties.limits.max_image_dimension3_d;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER
             | vk::BufferUsageFlags::TRANSFER_SRC
             | vk::BufferUsageFlags::TRANSFER_DST;
@@ -200,20 +218,39 @@ impl Pools {
         let nodes = u64::from(capacities.nodes);
         let leaf_side = pool_side(capacities.leaf_bricks);
         let interior_side = pool_side(capacities.interior_bricks);
-        let attribute = |name| {
-            Image::new(
-                ctx,
-                name,
-                ImageDesc::d3(
-                    vk::Format::R32_UINT,
-                    leaf_side * LEAF_BRICK_EDGE,
-                    1,
-                    vk::ImageUsageFlags::STORAGE
-                        | vk::ImageUsageFlags::TRANSFER_DST
-                        | vk::ImageUsageFlags::TRANSFER_SRC,
-                ),
-            )
+        let radiance_edge = interior_side.max(leaf_side) * layout::SVO_RADIANCE_BRICK;
+        ensure!(
+            6 * interior_side * layout::SVO_RADIANCE_BRICK <= max_3d
+                && leaf_side * layout::SVO_RADIANCE_BRICK <= max_3d,
+            "the SVO brick pools ({} leaf, {} interior bricks) exceed the device's 3D image \
+             size ({max_3d} texels, {radiance_edge} needed): use a smaller --octree-depth",
+            capacities.leaf_bricks,
+            capacities.interior_bricks
+        );
+        let usage = vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::TRANSFER_DST
+            | vk::ImageUsageFlags::TRANSFER_SRC;
+        let image = |name, format, edge, sampled: bool| {
+            let usage = if sampled {
+                usage | vk::ImageUsageFlags::SAMPLED
+            } else {
+                usage
+            };
+            Image::new(ctx, name, ImageDesc::d3(format, edge, 1, usage))
         };
+        let attribute_edge = leaf_side * layout::SVO_ATTRIBUTE_BRICK;
+        let packed = |name| image(name, vk::Format::R32_UINT, attribute_edge, false);
+        let rgba16 = vk::Format::R16G16B16A16_SFLOAT;
+        let interior_edge = interior_side * layout::SVO_RADIANCE_BRICK;
+        let mut directional_desc = ImageDesc::d3(
+            rgba16,
+            interior_edge,
+            1,
+            usage | vk::ImageUsageFlags::SAMPLED,
+        );
+        directional_desc.extent.width = 6 * interior_edge;
+        let list_words =
+            2 * u64::from(layout::SVO_ATTRIBUTE_BRICK).pow(3) * u64::from(capacities.leaf_bricks);
         Ok(Self {
             capacities,
             counters: buffer(
@@ -233,14 +270,29 @@ impl Pools {
             leaf_side,
             interior_side,
             leaf_attributes: [
-                attribute("svo leaf albedo")?,
-                attribute("svo leaf normal")?,
-                attribute("svo leaf emission")?,
+                packed("svo leaf albedo")?,
+                packed("svo leaf normal")?,
+                packed("svo leaf emission")?,
             ],
+            leaf_direct: image("svo leaf direct", rgba16, attribute_edge, false)?,
+            leaf_radiance: image(
+                "svo leaf radiance",
+                rgba16,
+                leaf_side * layout::SVO_RADIANCE_BRICK,
+                true,
+            )?,
+            directional: Image::new(ctx, "svo interior radiance", directional_desc)?,
+            voxel_list: buffer(
+                "svo voxel list",
+                std::mem::size_of::<VoxelListHeader>() as u64 + 4 * list_words,
+                vk::BufferUsageFlags::INDIRECT_BUFFER,
+            )?,
         })
     }
 
-    fn write_set(&self, ctx: &Context, set: vk::DescriptorSet) {
+    /// Writes the pools into the GI set: the octree's own bindings, and the bindings where
+    /// the dense grid has its volumes.
+    fn write_set(&self, ctx: &Context, set: vk::DescriptorSet, linear: vk::Sampler) {
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         let [albedo, normal, emission] = &self.leaf_attributes;
         SetWriter::new(ctx, set)
@@ -250,24 +302,46 @@ impl Pools {
             .buffer(layout::BINDING_SVO_NODE_COORDS, storage, self.coords.raw)
             .buffer(layout::BINDING_SVO_NODE_BRICKS, storage, self.bricks.raw)
             .buffer(layout::BINDING_SVO_NEIGHBOURS, storage, self.neighbours.raw)
-            .storage_image(layout::BINDING_SVO_BRICK_ALBEDO, albedo.view)
-            .storage_image(layout::BINDING_SVO_BRICK_NORMAL, normal.view)
-            .storage_image(layout::BINDING_SVO_BRICK_EMISSION, emission.view)
+            .buffer(layout::BINDING_GI_VOXEL_LIST, storage, self.voxel_list.raw)
+            .storage_image(layout::BINDING_GI_ALBEDO, albedo.view)
+            .storage_image(layout::BINDING_GI_NORMAL, normal.view)
+            .storage_image(layout::BINDING_GI_EMISSION, emission.view)
+            .storage_image(layout::BINDING_GI_DIRECT, self.leaf_direct.view)
+            .storage_image(layout::BINDING_GI_RADIANCE, self.leaf_radiance.view)
+            .storage_image(
+                layout::BINDING_SVO_DIRECTIONAL_STORAGE,
+                self.directional.view,
+            )
+            .sampled_image(
+                layout::BINDING_GI_RADIANCE_SAMPLED,
+                self.leaf_radiance.view,
+                linear,
+                vk::ImageLayout::GENERAL,
+            )
+            .sampled_image(
+                layout::BINDING_GI_DIRECTIONAL,
+                self.directional.view,
+                linear,
+                vk::ImageLayout::GENERAL,
+            )
             .apply();
     }
 
     fn bytes(&self) -> Vec<(&'static str, u64)> {
-        let [albedo, normal, emission] = &self.leaf_attributes;
+        let bricks: u64 = self
+            .leaf_attributes
+            .iter()
+            .chain([&self.leaf_direct, &self.leaf_radiance, &self.directional])
+            .map(Image::memory_bytes)
+            .sum();
         vec![
             ("svo_fragments", self.fragments.size),
             (
                 "svo_node_pool",
                 self.nodes.size + self.coords.size + self.bricks.size + self.neighbours.size,
             ),
-            (
-                "svo_brick_pool",
-                albedo.memory_bytes() + normal.memory_bytes() + emission.memory_bytes(),
-            ),
+            ("svo_brick_pool", bricks),
+            ("svo_voxel_list", self.voxel_list.size),
             ("svo_counters", self.counters.size),
         ]
     }
@@ -326,28 +400,26 @@ impl BuildReport {
     }
 }
 
-/// The set-2 bindings of the octree passes.
-fn svo_bindings() -> Vec<Binding> {
+/// The set-2 bindings of the octree's own buffers and images; the GI set holds them
+/// beside the bindings of the dense grid (`gi::gi_bindings`), where the octree binds its
+/// brick pools.
+pub fn bindings() -> Vec<Binding> {
     let all = vk::ShaderStageFlags::FRAGMENT
         | vk::ShaderStageFlags::COMPUTE
         | vk::ShaderStageFlags::GEOMETRY;
     let storage = vk::DescriptorType::STORAGE_BUFFER;
-    let image = vk::DescriptorType::STORAGE_IMAGE;
     vec![
-        Binding::new(
-            layout::BINDING_GI_UNIFORMS,
-            vk::DescriptorType::UNIFORM_BUFFER,
-            all,
-        ),
         Binding::new(layout::BINDING_SVO_COUNTERS, storage, all),
         Binding::new(layout::BINDING_SVO_FRAGMENTS, storage, all),
         Binding::new(layout::BINDING_SVO_NODES, storage, all),
         Binding::new(layout::BINDING_SVO_NODE_COORDS, storage, all),
         Binding::new(layout::BINDING_SVO_NODE_BRICKS, storage, all),
         Binding::new(layout::BINDING_SVO_NEIGHBOURS, storage, all),
-        Binding::new(layout::BINDING_SVO_BRICK_ALBEDO, image, all),
-        Binding::new(layout::BINDING_SVO_BRICK_NORMAL, image, all),
-        Binding::new(layout::BINDING_SVO_BRICK_EMISSION, image, all),
+        Binding::new(
+            layout::BINDING_SVO_DIRECTIONAL_STORAGE,
+            vk::DescriptorType::STORAGE_IMAGE,
+            all,
+        ),
     ]
 }
 
@@ -359,58 +431,31 @@ pub struct SvoGi {
     pools: Pools,
     fragments: VoxelizePass,
     octree: octree::OctreePasses,
-    fill: bricks::FillPass,
+    bricks: bricks::BrickPasses,
     report: Option<BuildReport>,
-    set: vk::DescriptorSet,
-    _sets: DescriptorSets,
-    /// Referenced by the set.
-    _uniforms: Buffer,
+    /// The radiance pools' sampler (the GI set refers to it).
+    linear: vk::Sampler,
     ctx: Arc<Context>,
 }
 
 impl SvoGi {
-    /// `set_layouts` are those of sets 0 and 1. `capacities` overrides the first guess of
-    /// the pool sizes (the overflow test starts from tiny pools).
+    /// `layouts` are those of sets 0, 1 and 2 (the GI set, into which the pools are
+    /// written, with `linear` as the radiance pools' sampler). `capacities` overrides the
+    /// first guess of the pool sizes (the overflow test starts from tiny pools).
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
         depth: u32,
         capacities: Option<Capacities>,
-        set_layouts: [vk::DescriptorSetLayout; 2],
+        layouts: [vk::DescriptorSetLayout; 3],
+        set: vk::DescriptorSet,
+        linear: vk::Sampler,
     ) -> Result<Self> {
         check_depth(depth)?;
-        if !ctx.features.geometry_shader || !ctx.features.fragment_stores_and_atomics {
-            bail!(
-                "--gi svo needs geometry shaders and fragment stores/atomics, which {} lacks",
-                ctx.device_name()
-            );
-        }
         let grid = Grid::around(scene, 1 << depth);
         let capacities = capacities.unwrap_or_else(|| Capacities::estimate(scene, &grid));
-        let pools = Pools::new(ctx, capacities, storage_limit(ctx))?;
-        let uniforms = GiUniforms {
-            origin: grid.origin.extend(grid.voxel_size).to_array(),
-            resolution: grid.resolution,
-            emission_range: emission_range(scene),
-            ..Default::default()
-        };
-        let uniforms = Buffer::with_data(
-            ctx,
-            "svo uniforms",
-            bytemuck::bytes_of(&uniforms),
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-        )?;
-        let sets = DescriptorSets::new(ctx, "svo", &svo_bindings(), 1)?;
-        let set = sets.allocate("svo")?;
-        SetWriter::new(ctx, set)
-            .buffer(
-                layout::BINDING_GI_UNIFORMS,
-                vk::DescriptorType::UNIFORM_BUFFER,
-                uniforms.raw,
-            )
-            .apply();
-        pools.write_set(ctx, set);
-        let layouts = [set_layouts[0], set_layouts[1], sets.layout];
+        let pools = Pools::new(ctx, capacities)?;
+        pools.write_set(ctx, set, linear);
         Ok(Self {
             grid,
             depth,
@@ -422,13 +467,29 @@ impl SvoGi {
                 layouts,
             )?,
             octree: octree::OctreePasses::new(ctx, layouts)?,
-            fill: bricks::FillPass::new(ctx, layouts)?,
+            bricks: bricks::BrickPasses::new(ctx, layouts)?,
             report: None,
-            set,
-            _sets: sets,
-            _uniforms: uniforms,
+            linear,
             ctx: ctx.clone(),
         })
+    }
+
+    /// The occupied leaf voxels: the indirect dispatch of voxel shading and bounces.
+    pub fn voxel_list(&self) -> vk::Buffer {
+        self.pools.voxel_list.raw
+    }
+
+    /// Filters the leaf radiance up the tree, bottom-up, with the bricks' borders copied
+    /// from their neighbours at every level (after voxel shading or a bounce).
+    pub fn record_filter(
+        &self,
+        cmd: vk::CommandBuffer,
+        frame_set: vk::DescriptorSet,
+        set: vk::DescriptorSet,
+    ) {
+        let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, set)];
+        self.bricks
+            .record_filter(&self.ctx, cmd, &sets, self.pools.counters.raw, self.depth);
     }
 
     /// The last build's report.
@@ -448,7 +509,7 @@ impl SvoGi {
     /// Builds the octree of the meshes at `draw.time_s` and waits for it. A pool that
     /// overflows is reported (a warning, and in the report), grown and the build runs
     /// again.
-    pub fn build(&mut self, draw: &SceneDraw) -> Result<&BuildReport> {
+    pub fn build(&mut self, draw: &SceneDraw, set: vk::DescriptorSet) -> Result<&BuildReport> {
         let start = Instant::now();
         let mut regrowths = Vec::new();
         loop {
@@ -462,7 +523,7 @@ impl SvoGi {
             )?;
             OneShot::new(&self.ctx)?.run("svo build", |cmd| {
                 timer.reset(cmd);
-                self.record_build(cmd, &mut timer, draw);
+                self.record_build(cmd, &mut timer, draw, set);
                 self.copy_counters(cmd, readback.raw);
                 Ok(())
             })?;
@@ -497,14 +558,20 @@ impl SvoGi {
                 "the SVO build still overflows after {} regrowths",
                 regrowths.len()
             );
-            self.pools = Pools::new(&self.ctx, grown, storage_limit(&self.ctx))
-                .context("growing the SVO pools")?;
-            self.pools.write_set(&self.ctx, self.set);
+            self.pools = Pools::new(&self.ctx, grown).context("growing the SVO pools")?;
+            self.pools.write_set(&self.ctx, set, self.linear);
         }
     }
 
-    /// Records the whole build: counters reset, fragments, octree, leaf bricks.
-    fn record_build(&self, cmd: vk::CommandBuffer, timer: &mut GpuTimer, draw: &SceneDraw) {
+    /// Records the whole build: counters reset, fragments, octree, leaf bricks, the list
+    /// of occupied leaf voxels, and cleared radiance pools.
+    fn record_build(
+        &self,
+        cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
+        draw: &SceneDraw,
+        set: vk::DescriptorSet,
+    ) {
         let ctx = &self.ctx;
         let p = &self.pools;
         let c = &p.capacities;
@@ -556,7 +623,7 @@ impl SvoGi {
 
         timer.begin(cmd, "fragments");
         self.fragments
-            .record(ctx, cmd, draw, self.set, self.grid.resolution, Meshes::All);
+            .record(ctx, cmd, draw, set, self.grid.resolution, Meshes::All);
         memory_barrier(
             ctx,
             cmd,
@@ -573,10 +640,7 @@ impl SvoGi {
         );
         timer.end(cmd);
 
-        let sets = [
-            (layout::SET_FRAME, draw.frame_set),
-            (layout::SET_PASS, self.set),
-        ];
+        let sets = [(layout::SET_FRAME, draw.frame_set), (layout::SET_PASS, set)];
         self.octree
             .record(ctx, cmd, timer, &sets, p.counters.raw, self.depth);
 
@@ -584,8 +648,51 @@ impl SvoGi {
         for image in &p.leaf_attributes {
             clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, BRICK_USE);
         }
-        self.fill.record(cmd, &sets, p.counters.raw);
+        self.bricks.record_fill(cmd, &sets, p.counters.raw);
         compute_to_compute(ctx, cmd);
+        timer.end(cmd);
+
+        timer.begin(cmd, "voxel list");
+        let empty = VoxelListHeader {
+            groups_x: 0,
+            groups_y: 1,
+            groups_z: 1,
+            count: 0,
+        };
+        unsafe {
+            ctx.device
+                .cmd_update_buffer(cmd, p.voxel_list.raw, 0, bytemuck::bytes_of(&empty))
+        };
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE,
+            ),
+        );
+        self.bricks
+            .record_list(cmd, &sets, p.counters.raw, self.depth - 1);
+        // Voxel shading writes only the listed voxels: the others must read zero.
+        for image in [&p.leaf_direct, &p.leaf_radiance, &p.directional] {
+            clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, RADIANCE_USE);
+        }
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
+                vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+            ),
+        );
         timer.end(cmd);
     }
 
@@ -623,11 +730,6 @@ const BRICK_USE: ImageUse = ImageUse {
             | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
     ),
 };
-
-/// The largest storage buffer the device binds.
-fn storage_limit(ctx: &Context) -> u64 {
-    u64::from(ctx.properties.limits.max_storage_buffer_range)
-}
 
 #[cfg(test)]
 impl SvoGi {

@@ -8,8 +8,9 @@ use ash::vk;
 use super::{Capacities, SvoGi};
 use crate::frontend::LDR_FORMAT;
 use crate::gi::reference;
+use crate::gi::VoxelStructure;
 use crate::gpu_layout::{self as layout, VoxelFragment};
-use crate::renderer::{RenderSettings, Renderer, SvoSettings};
+use crate::renderer::{GiSettings, RenderSettings, Renderer};
 use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
 use crate::vk::{Context, ContextOptions};
@@ -23,7 +24,13 @@ fn build(scene: Scene, depth: u32, capacities: Option<Capacities>) -> (Arc<Conte
     })
     .unwrap();
     let settings = RenderSettings {
-        svo: Some(SvoSettings { depth, capacities }),
+        gi: Some(GiSettings {
+            voxels: 1 << depth,
+            structure: VoxelStructure::Octree { capacities },
+            cones: Default::default(),
+            shadow_cones: false,
+            full_update: false,
+        }),
         ..Default::default()
     };
     let extent = vk::Extent2D {
@@ -195,7 +202,7 @@ fn check_octree(scene: Scene, depth: u32) {
     let triangles = reference::world_triangles(&scene);
     let solid = reference::world_triangles_where(&scene, |m| m.coverage_texture.is_none());
     let (ctx, renderer) = build(scene, depth, None);
-    let svo = renderer.svo().unwrap();
+    let svo = renderer.gi().unwrap().octree().unwrap();
     let d = download(svo);
     let voxels = check_structure(svo, &d);
 
@@ -273,7 +280,7 @@ fn rgba(v: u32) -> [f32; 4] {
 fn leaf_bricks_average_their_fragments() {
     let Some(scene) = cornell() else { return };
     let (ctx, renderer) = build(scene, 6, None);
-    let svo = renderer.svo().unwrap();
+    let svo = renderer.gi().unwrap().octree().unwrap();
     let d = download(svo);
     let depth = svo.depth;
     let (leaf_first, leaf_count) = d.levels[depth as usize - 1];
@@ -281,11 +288,11 @@ fn leaf_bricks_average_their_fragments() {
         .map(|n| (d.coords[n as usize], n))
         .collect();
     let side = svo.pools.leaf_side;
-    let edge = side * super::LEAF_BRICK_EDGE;
+    let edge = side * layout::SVO_ATTRIBUTE_BRICK;
     let texel_of = |v: [u32; 3]| -> usize {
         let brick = d.bricks[leaf_of[&v.map(|c| c >> 1)] as usize];
         let origin = [brick % side, (brick / side) % side, brick / (side * side)];
-        let t = [0, 1, 2].map(|a| origin[a] * super::LEAF_BRICK_EDGE + (v[a] & 1));
+        let t = [0, 1, 2].map(|a| origin[a] * layout::SVO_ATTRIBUTE_BRICK + (v[a] & 1));
         (t[0] + edge * (t[1] + edge * t[2])) as usize
     };
     let mut sums: HashMap<usize, ([[f64; 3]; 3], u32)> = HashMap::new();
@@ -341,7 +348,10 @@ fn tiny_pools_grow_and_rebuild() {
     };
     let (ctx, grown) = build(scene.clone(), 6, Some(tiny));
     let (_, roomy) = build(scene, 6, None);
-    let (a, b) = (grown.svo().unwrap(), roomy.svo().unwrap());
+    let (a, b) = (
+        grown.gi().unwrap().octree().unwrap(),
+        roomy.gi().unwrap().octree().unwrap(),
+    );
     let report = a.report().unwrap();
     eprintln!("{}", report.regrowths.join("\n"));
     assert!(!report.regrowths.is_empty());

@@ -1,4 +1,5 @@
 #version 460
+// variant: VOXELS_SVO
 // Voxel cone tracing (Crassin et al. 2011) for one G-buffer pixel of each
 // indirect_scale² block: cosine-weighted diffuse cones over the normal's hemisphere are
 // marched front to back through the voxel radiance, the sky filling what they leave

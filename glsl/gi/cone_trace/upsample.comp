@@ -1,4 +1,5 @@
 #version 460
+// variant: VOXELS_SVO
 // The composite of the GI terms, per pixel at full resolution:
 // - indirect diffuse: a depth- and normal-aware upsample of the gathered light (each
 //   pixel blends the four nearest reduced-resolution samples bilinearly, down-weighting

@@ -1,4 +1,5 @@
 #version 460
+// variant: VOXELS_SVO
 // One more bounce of light between voxels (Villegas 2018 §4), over the list of occupied
 // voxels (compact.comp): each gathers the filtered radiance over the hemisphere of its
 // lit face (injection turned the normal to it) and adds albedo times it to its direct
@@ -13,22 +14,22 @@ layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform readonly uima
 layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform readonly image3D voxel_direct;
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance_out;
 
-
 // Cones per voxel gather, whatever --diffuse-cones asks of the screen: six cover the
 // hemisphere well enough for light that is filtered again before anyone sees it.
 const int BOUNCE_CONES = 6;
 
 void main() {
-    ivec3 voxel;
-    if (!listed_voxel(voxel)) {
+    ListedVoxel entry;
+    if (!listed_voxel(entry)) {
         return;
     }
+    ivec3 voxel = entry.texel;
     vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, voxel).r);
     vec3 n = unpack_rgba8(imageLoad(voxel_normal, voxel).r).xyz / 255.0 * 2.0 - 1.0;
     n = length(n) > 0.2 ? normalize(n) : vec3(0.0, 1.0, 0.0);
-    vec3 p = voxel_center(voxel);
+    vec3 p = voxel_center(entry.voxel);
     float offset = 1.5 * gi.origin.w;
     vec3 gathered = gather_diffuse(p, p + n * offset, n, BOUNCE_CONES, 1.0, false).rgb;
     vec4 direct = imageLoad(voxel_direct, voxel);
-    imageStore(voxel_radiance_out, voxel, vec4(direct.rgb + albedo.rgb / 255.0 * gathered, direct.a));
+    imageStore(voxel_radiance_out, entry.radiance_texel, vec4(direct.rgb + albedo.rgb / 255.0 * gathered, direct.a));
 }

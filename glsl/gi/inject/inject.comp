@@ -1,10 +1,12 @@
 #version 460
+// variant: VOXELS_SVO
 // Deferred voxel shading (Villegas 2018), over the list of occupied voxels (the others
 // were cleared to zero): per occupied voxel, outgoing radiance =
 // albedo / pi * direct irradiance (the surface shading's units) + emission, stored
 // premultiplied by opacity. Visibility comes from the shadow maps (one bilinear compare:
 // a voxel is wider than the PCF kernel), or with soft-shadow cones, which make the
 // shadow maps unnecessary, from a ray marched through the voxels towards the light.
+// With VOXELS_SVO the voxels are the octree's leaf voxels, in their bricks.
 #include "common/frame.glsl"
 #include "common/direct_light.glsl"
 #include "gi/voxels.glsl"
@@ -17,6 +19,20 @@ layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform readonly ui
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance;
 layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform writeonly image3D voxel_direct;
 
+// Whether voxel v of the grid holds a surface.
+bool voxel_occupied(ivec3 v) {
+#ifdef VOXELS_SVO
+    uint leaf = find_node(uvec3(v), svo_depth() - 1u);
+    if (leaf == SVO_NO_NODE || node_bricks[leaf] == SVO_NO_BRICK) {
+        return false;
+    }
+    ivec3 texel = brick_origin(node_bricks[leaf], counters.leaf_pool_side, SVO_ATTRIBUTE_BRICK) + (v & 1);
+    return (imageLoad(voxel_albedo, texel).r >> 24) != 0u;
+#else
+    return (imageLoad(voxel_albedo, v).r >> 24) != 0u;
+#endif
+}
+
 // Whether the segment from p (offset along n) towards the light, up to `dist`, passes no
 // occupied voxel: one sample per voxel length.
 float voxel_visibility(vec3 p, vec3 n, vec3 to_light, float dist) {
@@ -28,7 +44,7 @@ float voxel_visibility(vec3 p, vec3 n, vec3 to_light, float dist) {
         if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(gi.resolution)))) {
             break;
         }
-        if ((imageLoad(voxel_albedo, v).r >> 24) != 0u) {
+        if (voxel_occupied(v)) {
             return 0.0;
         }
     }
@@ -59,10 +75,11 @@ vec3 voxel_irradiance(GpuLight light, vec3 p, vec3 n) {
 }
 
 void main() {
-    ivec3 voxel;
-    if (!listed_voxel(voxel)) {
+    ListedVoxel entry;
+    if (!listed_voxel(entry)) {
         return;
     }
+    ivec3 voxel = entry.texel;
     vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, voxel).r);
     vec3 rho = albedo.rgb / 255.0;
     vec4 packed_normal = unpack_rgba8(imageLoad(voxel_normal, voxel).r);
@@ -70,7 +87,7 @@ void main() {
     float len = length(n);
     // Opposite normals averaged in one voxel cancel; such a voxel faces every way.
     n = len > 0.2 ? n / len : vec3(0.0, 1.0, 0.0);
-    vec3 p = voxel_center(voxel);
+    vec3 p = voxel_center(entry.voxel);
     // Surfaces are two-sided: the voxel keeps the face that receives more light (emitters
     // their winding face), and its normal is turned to that face so that the filter
     // shows this radiance only to cones that look at the face.
@@ -88,6 +105,6 @@ void main() {
         imageStore(voxel_normal, voxel, uvec4(pack_rgba8(vec4((lit * 0.5 + 0.5) * 255.0, packed_normal.a))));
     }
     vec4 radiance = vec4(rho / PI * e + emission, 1.0);
-    imageStore(voxel_radiance, voxel, radiance);
+    imageStore(voxel_radiance, entry.radiance_texel, radiance);
     imageStore(voxel_direct, voxel, radiance);
 }

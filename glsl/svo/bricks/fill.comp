@@ -6,9 +6,9 @@
 #include "svo/octree.glsl"
 
 layout(local_size_x = SVO_GROUP_SIZE) in;
-layout(set = SET_PASS, binding = BINDING_SVO_BRICK_ALBEDO, r32ui) uniform coherent volatile uimage3D brick_albedo;
-layout(set = SET_PASS, binding = BINDING_SVO_BRICK_NORMAL, r32ui) uniform coherent volatile uimage3D brick_normal;
-layout(set = SET_PASS, binding = BINDING_SVO_BRICK_EMISSION, r32ui) uniform coherent volatile uimage3D brick_emission;
+layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform coherent volatile uimage3D brick_albedo;
+layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform coherent volatile uimage3D brick_normal;
+layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform coherent volatile uimage3D brick_emission;
 
 DEFINE_AVERAGE(average_albedo, brick_albedo)
 DEFINE_AVERAGE(average_normal, brick_normal)
@@ -25,7 +25,7 @@ void main() {
     if (leaf == SVO_NO_NODE || node_bricks[leaf] == SVO_NO_BRICK) {
         return;
     }
-    ivec3 texel = brick_origin(node_bricks[leaf], counters.leaf_pool_side, 2u) + ivec3(v & 1u);
+    ivec3 texel = brick_origin(node_bricks[leaf], counters.leaf_pool_side, SVO_ATTRIBUTE_BRICK) + ivec3(v & 1u);
     average_albedo(texel, unpack_rgba8(f.albedo).rgb);
     average_normal(texel, unpack_rgba8(f.normal).rgb);
     average_emission(texel, unpack_rgba8(f.emission).rgb);

@@ -1,0 +1,144 @@
+// How cones read the filtered voxel radiance: the base level (one voxel wide) and the
+// six directional levels above it, from the dense grid's 3D textures or, with
+// VOXELS_SVO, from the octree's bricks (Dřínovský 2013, 5.6). Both give the same values:
+// a brick holds its node's 2x2x2 voxels, at voxel centres as in the dense grid, with a
+// border copied from the neighbours, so trilinear filtering inside a node reads what the
+// dense texture would.
+#ifndef SAMPLING_GLSL
+#define SAMPLING_GLSL
+#include "gi/voxels.glsl"
+
+layout(set = SET_PASS, binding = BINDING_GI_RADIANCE_SAMPLED) uniform sampler3D voxel_radiance;
+layout(set = SET_PASS, binding = BINDING_GI_DIRECTIONAL) uniform sampler3D voxel_directional;
+
+#ifndef VOXELS_SVO
+
+// The base level at `uvw`.
+vec4 sample_base(vec3 uvw) {
+    return textureLod(voxel_radiance, uvw, 0.0);
+}
+
+// The directional volume d (+X -X +Y -Y +Z -Z) at `uvw` and mip level `level`, a whole
+// level. The six sit side by side along x; x is kept half a texel inside the volume so
+// that filtering never mixes two directions.
+vec4 sample_directional_level(int d, vec3 uvw, float level) {
+    float edge = float(max(int(gi.resolution) >> (int(level) + 1), 1));
+    float margin = 0.5 / edge;
+    vec3 packed_uvw = vec3((float(d) + clamp(uvw.x, margin, 1.0 - margin)) / 6.0, uvw.yz);
+    return textureLod(voxel_directional, packed_uvw, level);
+}
+
+// The directional volume d at `uvw` and mip `level`, blending two levels. The coarsest,
+// a single voxel, is left out, as the octree has no level above its root's bricks.
+vec4 sample_directional(int d, vec3 uvw, float level) {
+    float l = clamp(level, 0.0, float(gi.directional_levels) - 2.0);
+    float below = floor(l);
+    vec4 near = sample_directional_level(d, uvw, below);
+    return l > below ? mix(near, sample_directional_level(d, uvw, below + 1.0), l - below) : near;
+}
+
+// The three directional volumes facing a cone travelling along `dir`.
+void sample_facing(vec3 uvw, vec3 dir, float level, out vec4 sx, out vec4 sy, out vec4 sz) {
+    sx = sample_directional(dir.x >= 0.0 ? 0 : 1, uvw, level);
+    sy = sample_directional(dir.y >= 0.0 ? 2 : 3, uvw, level);
+    sz = sample_directional(dir.z >= 0.0 ? 4 : 5, uvw, level);
+}
+
+#else
+#include "svo/octree.glsl"
+
+// A place in a brick: the brick and the position in texels of its interior (0..2).
+struct BrickSample {
+    uint brick;
+    vec3 local;
+};
+
+// The brick of the node at `level` whose cube holds `uvw` (clamped to the grid, as the
+// dense sampler clamps to its edge); false where the octree is empty there: the descent
+// stops at the first missing node, skipping the empty space below it.
+bool locate(vec3 uvw, uint level, out BrickSample s) {
+    float voxels = float(2u << level);
+    vec3 q = clamp(uvw, 0.0, 1.0) * voxels;
+    uvec3 node_coords = min(uvec3(q * 0.5), uvec3((1u << level) - 1u));
+    uint node = find_node(node_coords << (svo_depth() - level), level);
+    s.brick = node == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[node];
+    s.local = q - vec3(node_coords * 2u);
+    return s.brick != SVO_NO_BRICK;
+}
+
+// Leaf radiance, trilinear, at a located place.
+vec4 read_leaf(BrickSample s) {
+    float edge = float(counters.leaf_pool_side * SVO_RADIANCE_BRICK);
+    vec3 texel = vec3(brick_origin(s.brick, counters.leaf_pool_side, SVO_RADIANCE_BRICK)) + 1.0 + s.local;
+    return textureLod(voxel_radiance, texel / edge, 0.0);
+}
+
+// Directional radiance d of an interior brick, trilinear, at a located place. The six
+// directions of a brick sit side by side along x, one pool width apart.
+vec4 read_interior(BrickSample s, int d) {
+    float edge = float(counters.interior_pool_side * SVO_RADIANCE_BRICK);
+    vec3 texel = vec3(brick_origin(s.brick, counters.interior_pool_side, SVO_RADIANCE_BRICK)) + 1.0 + s.local;
+    texel.x += float(d) * edge;
+    return textureLod(voxel_directional, texel / vec3(6.0 * edge, edge, edge), 0.0);
+}
+
+vec4 sample_base(vec3 uvw) {
+    BrickSample s;
+    return locate(uvw, svo_depth() - 1u, s) ? read_leaf(s) : vec4(0.0);
+}
+
+// Directional level `level` (0: voxels twice the leaves' size) is held by the interior
+// nodes at depth - 2 - level; a fractional level blends two (quadrilinear). The root's
+// bricks are the coarsest level (the dense chain goes one further, to a single voxel).
+void level_pair(float level, out uint fine, out uint coarse, out float t) {
+    float top = float(svo_depth()) - 2.0;
+    float l = clamp(level, 0.0, top);
+    float below = floor(l);
+    t = l - below;
+    fine = uint(top - below);
+    coarse = fine > 0u ? fine - 1u : 0u;
+}
+
+vec4 sample_directional(int d, vec3 uvw, float level) {
+    uint fine;
+    uint coarse;
+    float t;
+    level_pair(level, fine, coarse, t);
+    BrickSample a;
+    BrickSample b;
+    vec4 near = locate(uvw, fine, a) ? read_interior(a, d) : vec4(0.0);
+    vec4 far = (t > 0.0 && locate(uvw, coarse, b)) ? read_interior(b, d) : vec4(0.0);
+    return mix(near, far, t);
+}
+
+void sample_facing(vec3 uvw, vec3 dir, float level, out vec4 sx, out vec4 sy, out vec4 sz) {
+    uint fine;
+    uint coarse;
+    float t;
+    level_pair(level, fine, coarse, t);
+    ivec3 d = ivec3(dir.x >= 0.0 ? 0 : 1, dir.y >= 0.0 ? 2 : 3, dir.z >= 0.0 ? 4 : 5);
+    sx = vec4(0.0);
+    sy = vec4(0.0);
+    sz = vec4(0.0);
+    BrickSample s;
+    if (locate(uvw, fine, s)) {
+        sx = read_interior(s, d.x);
+        sy = read_interior(s, d.y);
+        sz = read_interior(s, d.z);
+    }
+    if (t > 0.0) {
+        vec4 cx = vec4(0.0);
+        vec4 cy = vec4(0.0);
+        vec4 cz = vec4(0.0);
+        if (locate(uvw, coarse, s)) {
+            cx = read_interior(s, d.x);
+            cy = read_interior(s, d.y);
+            cz = read_interior(s, d.z);
+        }
+        sx = mix(sx, cx, t);
+        sy = mix(sy, cy, t);
+        sz = mix(sz, cz, t);
+    }
+}
+#endif
+#endif

@@ -1,0 +1,60 @@
+#version 460
+// Border transfer (Dřínovský 2013, 5.4.2; Crassin's brick borders): the one-voxel border
+// of every brick of level `push.level` gets the values of the neighbouring bricks'
+// voxels there, so that trilinear filtering anywhere inside a node reads what the dense
+// grid would. The neighbour holding a border voxel is reached through the neighbour
+// pointers (one to three hops); where a hop meets no node, the octree is searched from
+// the root (a diagonal neighbour can exist beside missing face neighbours). At the grid's
+// edge the border repeats the edge voxel, as the dense sampler clamps to its edge.
+#include "svo/octree/level.glsl"
+
+layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform image3D leaf_radiance;
+layout(set = SET_PASS, binding = BINDING_SVO_DIRECTIONAL_STORAGE, rgba16f) uniform image3D directional;
+
+// The node of this level at offset `step` (each -1, 0 or 1) from `node` at `coords`.
+uint offset_node(uint node, ivec3 coords, ivec3 step) {
+    uint n = node;
+    for (int axis = 0; axis < 3 && n != SVO_NO_NODE; axis++) {
+        if (step[axis] != 0) {
+            n = node_neighbours[6u * n + uint(2 * axis + (step[axis] > 0 ? 0 : 1))];
+        }
+    }
+    if (n == SVO_NO_NODE) {
+        n = find_node(uvec3(coords + step) << (svo_depth() - push.level), push.level);
+    }
+    return n;
+}
+
+void main() {
+    uint node;
+    if (!level_node(node) || node_bricks[node] == SVO_NO_BRICK) {
+        return;
+    }
+    bool leaf = push.level + 1u == svo_depth();
+    uint side = leaf ? counters.leaf_pool_side : counters.interior_pool_side;
+    int direction_stride = int(side * SVO_RADIANCE_BRICK);
+    ivec3 origin = brick_origin(node_bricks[node], side, SVO_RADIANCE_BRICK) + 1;
+    ivec3 coords = ivec3(unpack_coord(node_coords[node]));
+    int last = (2 << push.level) - 1;
+    for (int i = 0; i < 64; i++) {
+        ivec3 t = ivec3(i & 3, (i >> 2) & 3, i >> 4) - 1;
+        if (all(greaterThanEqual(t, ivec3(0))) && all(lessThanEqual(t, ivec3(1)))) {
+            continue;
+        }
+        ivec3 g = clamp(coords * 2 + t, ivec3(0), ivec3(last));
+        ivec3 step = (g >> 1) - coords;
+        uint owner = all(equal(step, ivec3(0))) ? node : offset_node(node, coords, step);
+        uint brick = owner == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[owner];
+        ivec3 from = brick == SVO_NO_BRICK ? ivec3(0) : brick_origin(brick, side, SVO_RADIANCE_BRICK) + 1 + (g & 1);
+        if (leaf) {
+            vec4 value = brick == SVO_NO_BRICK ? vec4(0.0) : imageLoad(leaf_radiance, from);
+            imageStore(leaf_radiance, origin + t, value);
+        } else {
+            for (int d = 0; d < 6; d++) {
+                ivec3 shift = ivec3(d * direction_stride, 0, 0);
+                vec4 value = brick == SVO_NO_BRICK ? vec4(0.0) : imageLoad(directional, from + shift);
+                imageStore(directional, origin + t + shift, value);
+            }
+        }
+    }
+}
