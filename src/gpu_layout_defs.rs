@@ -114,6 +114,10 @@ gpu_layout! {
         BINDING_SVO_NEIGHBOURS = 25;
         /// SVO passes (set 2): the interior bricks' six directional radiances, `rgba16f` storage (sampled at `BINDING_GI_DIRECTIONAL`).
         BINDING_SVO_DIRECTIONAL_STORAGE = 26;
+        /// SVO passes (set 2): per leaf voxel, the sums of its fragments' albedo, normal and emission (RGB, 0..255 each) and their count, `SVO_SUM_WORDS` words of a `uint[]` storage buffer: atomic adds are exact and commutative, so the averages do not depend on the order the fragments were listed in.
+        BINDING_SVO_SUMS = 27;
+        /// Words per leaf voxel in the sums buffer.
+        SVO_SUM_WORDS = 10;
         /// Edge of a leaf attribute brick (albedo, normal, emission, direct light): the leaf's 2x2x2 voxels.
         SVO_ATTRIBUTE_BRICK = 2;
         /// Edge of a radiance brick: the node's 2x2x2 voxels and a border of one voxel copied from the neighbours, so that trilinear filtering inside the node needs no other brick.
@@ -270,7 +274,7 @@ gpu_layout! {
         vec4 origin,
         /// Voxels per axis.
         uint resolution,
-        /// Mip levels of the directional volumes (resolution / 2 down to 1).
+        /// Mip levels of the directional volumes (resolution / 2 down to 2).
         uint directional_levels,
         /// Emission is stored divided by this (the scene's largest emitted radiance).
         float emission_range,

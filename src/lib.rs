@@ -17,4 +17,6 @@ pub mod scene;
 pub mod scene_gpu;
 pub mod shadow;
 pub mod svo;
+#[cfg(test)]
+mod testing;
 pub mod vk;

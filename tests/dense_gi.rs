@@ -5,7 +5,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{assert_clean, shared, temp_dir, voxcone};
+use common::{render_256, shared, temp_dir};
 use voxcone::compare::{compare, CompareOptions};
 use voxcone::imageio::load_rgb;
 
@@ -14,18 +14,9 @@ fn render(scene: &Path, gi: &str, out: &Path) {
 }
 
 fn render_with(scene: &Path, gi: &str, out: &Path, extra: &[&str]) {
-    let mut args = vec![
-        "render",
-        scene.to_str().unwrap(),
-        "--gi",
-        gi,
-        "--size",
-        "256x256",
-        "-o",
-        out.to_str().unwrap(),
-    ];
+    let mut args = vec!["--gi", gi];
     args.extend_from_slice(extra);
-    assert_clean(&voxcone(&args));
+    render_256(scene, &args, out);
 }
 
 /// Mean red minus green of the floor strip next to the left (red) and right (green) walls.

@@ -18,23 +18,15 @@ vec4 sample_base(vec3 uvw) {
     return textureLod(voxel_radiance, uvw, 0.0);
 }
 
-// The directional volume d (+X -X +Y -Y +Z -Z) at `uvw` and mip level `level`, a whole
-// level. The six sit side by side along x; x is kept half a texel inside the volume so
-// that filtering never mixes two directions.
-vec4 sample_directional_level(int d, vec3 uvw, float level) {
-    float edge = float(max(int(gi.resolution) >> (int(level) + 1), 1));
-    float margin = 0.5 / edge;
-    vec3 packed_uvw = vec3((float(d) + clamp(uvw.x, margin, 1.0 - margin)) / 6.0, uvw.yz);
-    return textureLod(voxel_directional, packed_uvw, level);
-}
-
-// The directional volume d at `uvw` and mip `level`, blending two levels. The coarsest,
-// a single voxel, is left out, as the octree has no level above its root's bricks.
+// The directional volume d (+X -X +Y -Y +Z -Z) at `uvw` and mip `level`, one trilinear
+// fetch blending two levels. The six sit side by side along x, each in the middle of a
+// slot twice its width whose margins repeat its edge voxels (filter.comp), so that
+// filtering clamps at the cube's faces as at the texture's and never mixes two
+// directions, at every level alike.
 vec4 sample_directional(int d, vec3 uvw, float level) {
-    float l = clamp(level, 0.0, float(gi.directional_levels) - 2.0);
-    float below = floor(l);
-    vec4 near = sample_directional_level(d, uvw, below);
-    return l > below ? mix(near, sample_directional_level(d, uvw, below + 1.0), l - below) : near;
+    float l = clamp(level, 0.0, float(gi.directional_levels) - 1.0);
+    float x = (float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / 6.0;
+    return textureLod(voxel_directional, vec3(x, uvw.yz), l);
 }
 
 // The three directional volumes facing a cone travelling along `dir`.

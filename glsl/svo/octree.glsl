@@ -25,6 +25,9 @@ layout(set = SET_PASS, binding = BINDING_SVO_NODE_BRICKS, std430) buffer BricksB
 layout(set = SET_PASS, binding = BINDING_SVO_NEIGHBOURS, std430) buffer NeighboursBlock {
     uint node_neighbours[];
 };
+layout(set = SET_PASS, binding = BINDING_SVO_SUMS, std430) buffer SumsBlock {
+    uint leaf_sums[];
+};
 
 // Mask of a child entry's tile index.
 #define SVO_CHILD_MASK (~SVO_SUBDIVIDE)
@@ -59,6 +62,12 @@ uint find_node(uvec3 v, uint level) {
         node = tile + child_octant(v, l);
     }
     return node;
+}
+
+// The first word of voxel v's sums in leaf brick `brick`.
+uint leaf_sum_base(uint brick, uvec3 v) {
+    uvec3 k = v & 1u;
+    return SVO_SUM_WORDS * (8u * brick + (k.x | (k.y << 1) | (k.z << 2)));
 }
 
 // The corner texel of brick `slot` in a pool of `side`³ bricks of `edge`³ texels.

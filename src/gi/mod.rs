@@ -189,10 +189,23 @@ struct Volumes {
     /// voxelization of the moving meshes from (only when the scene has moving meshes and
     /// the static voxels are not re-voxelized every frame).
     static_packed: Option<[Image; 3]>,
-    /// +X -X +Y -Y +Z -Z side by side along x, each resolution / 2 with a full mip chain:
-    /// one texture, so that a cone picks its volume by coordinate (descriptor arrays need
-    /// constant indices on lavapipe, and branching over six textures costs twice as much).
+    /// +X -X +Y -Y +Z -Z side by side along x, each resolution / 2 down to 2 in its mip
+    /// chain: one texture, so that a cone picks its volume by coordinate (descriptor
+    /// arrays need constant indices on lavapipe, and branching over six textures costs
+    /// twice as much). Each cube of edge w sits in a slot 2w wide, with w/2 texels on
+    /// either side, so that one trilinear fetch blending two levels never reaches the
+    /// next direction's cube ([`DIRECTIONAL_SLOT`]).
     directional: Image,
+}
+
+/// Width of a direction's slot in the directional texture, in cube edges: the cube in its
+/// middle (`glsl/gi/sampling.glsl`, `glsl/gi/filter/filter.comp`).
+const DIRECTIONAL_SLOT: u32 = 2;
+
+/// Levels of the directional mip chain of an `n`³ grid: n/2 down to 2 (a single voxel
+/// for the whole grid tells a cone nothing, and the octree has no such level either).
+fn directional_levels(n: u32) -> u32 {
+    n.trailing_zeros() - 1
 }
 
 const PACKED_FORMAT: vk::Format = vk::Format::R32_UINT;
@@ -227,9 +240,13 @@ impl Volumes {
             | vk::ImageUsageFlags::SAMPLED
             | vk::ImageUsageFlags::TRANSFER_SRC
             | vk::ImageUsageFlags::TRANSFER_DST;
-        let mut directional_desc =
-            ImageDesc::d3(RADIANCE_FORMAT, n / 2, n.trailing_zeros(), radiance_usage);
-        directional_desc.extent.width = 6 * (n / 2);
+        let mut directional_desc = ImageDesc::d3(
+            RADIANCE_FORMAT,
+            n / 2,
+            directional_levels(n),
+            radiance_usage,
+        );
+        directional_desc.extent.width = 6 * DIRECTIONAL_SLOT * (n / 2);
         let directional = Image::new(ctx, "voxel radiance directional", directional_desc)?;
         let static_packed = static_copies
             .then(|| -> Result<[Image; 3]> {
@@ -651,7 +668,7 @@ impl VoxelGi {
         let uniforms = GiUniforms {
             origin: grid.origin.extend(grid.voxel_size).to_array(),
             resolution,
-            directional_levels: resolution.trailing_zeros(),
+            directional_levels: directional_levels(resolution),
             emission_range: emission_range(scene),
             step_factor: cones.step_factor,
             diffuse_tan_half: (cones.diffuse_aperture_deg.to_radians() * 0.5).tan(),
@@ -975,7 +992,7 @@ impl VoxelGi {
             Volume::Radiance => &v.radiance,
             Volume::Directional(_) => &v.directional,
         };
-        // Edge of the level; the directional texture is six such cubes wide.
+        // Edge of the level; the directional texture is six slots of two such cubes wide.
         let n = (image.desc.extent.height >> level).max(1);
         let width = (image.desc.extent.width >> level).max(1);
         let texel = if image.desc.format == PACKED_FORMAT {
@@ -995,12 +1012,13 @@ impl VoxelGi {
         };
         let bytes = read_back_image(&self.ctx, image, level, extent, texel, any_shader)?;
         Ok(match volume {
-            // Direction d's cube: the d-th run of n texels in every row.
+            // Direction d's cube: in every row, n texels from the middle of slot d.
             Volume::Directional(d) => {
                 let row = n as usize * texel as usize;
+                let start = (DIRECTIONAL_SLOT as usize * d) * row + row / 2;
                 bytes
                     .chunks_exact(width as usize * texel as usize)
-                    .flat_map(|r| &r[d * row..(d + 1) * row])
+                    .flat_map(|r| &r[start..start + row])
                     .copied()
                     .collect()
             }

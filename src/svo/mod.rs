@@ -186,6 +186,8 @@ struct Pools {
     directional: Image,
     /// The occupied leaf voxels with their bricks (`VoxelListHeader`, then two words each).
     voxel_list: Buffer,
+    /// Per leaf voxel, its fragments' attribute sums and count (`SVO_SUM_WORDS` words).
+    sums: Buffer,
 }
 
 const COUNTERS_BYTES: usize = std::mem::size_of::<SvoCounters>()
@@ -287,6 +289,13 @@ impl Pools {
                 std::mem::size_of::<VoxelListHeader>() as u64 + 4 * list_words,
                 vk::BufferUsageFlags::INDIRECT_BUFFER,
             )?,
+            sums: buffer(
+                "svo fragment sums",
+                4 * u64::from(layout::SVO_SUM_WORDS)
+                    * u64::from(layout::SVO_ATTRIBUTE_BRICK).pow(3)
+                    * u64::from(capacities.leaf_bricks),
+                vk::BufferUsageFlags::empty(),
+            )?,
         })
     }
 
@@ -303,6 +312,7 @@ impl Pools {
             .buffer(layout::BINDING_SVO_NODE_BRICKS, storage, self.bricks.raw)
             .buffer(layout::BINDING_SVO_NEIGHBOURS, storage, self.neighbours.raw)
             .buffer(layout::BINDING_GI_VOXEL_LIST, storage, self.voxel_list.raw)
+            .buffer(layout::BINDING_SVO_SUMS, storage, self.sums.raw)
             .storage_image(layout::BINDING_GI_ALBEDO, albedo.view)
             .storage_image(layout::BINDING_GI_NORMAL, normal.view)
             .storage_image(layout::BINDING_GI_EMISSION, emission.view)
@@ -342,6 +352,7 @@ impl Pools {
             ),
             ("svo_brick_pool", bricks),
             ("svo_voxel_list", self.voxel_list.size),
+            ("svo_fragment_sums", self.sums.size),
             ("svo_counters", self.counters.size),
         ]
     }
@@ -415,6 +426,7 @@ pub fn bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_SVO_NODE_COORDS, storage, all),
         Binding::new(layout::BINDING_SVO_NODE_BRICKS, storage, all),
         Binding::new(layout::BINDING_SVO_NEIGHBOURS, storage, all),
+        Binding::new(layout::BINDING_SVO_SUMS, storage, all),
         Binding::new(
             layout::BINDING_SVO_DIRECTIONAL_STORAGE,
             vk::DescriptorType::STORAGE_IMAGE,
@@ -603,6 +615,8 @@ impl SvoGi {
             // The root: no children yet, at (0, 0, 0).
             ctx.device.cmd_fill_buffer(cmd, p.nodes.raw, 0, 4, 0);
             ctx.device.cmd_fill_buffer(cmd, p.coords.raw, 0, 4, 0);
+            ctx.device
+                .cmd_fill_buffer(cmd, p.sums.raw, 0, vk::WHOLE_SIZE, 0);
         }
         memory_barrier(
             ctx,

@@ -57,3 +57,17 @@ pub fn assert_clean(output: &Output) {
         "validation was not on or not clean: {err}"
     );
 }
+
+/// Renders `scene` at 256x256 to `out` with the options `extra`, validation clean.
+pub fn render_256(scene: &Path, extra: &[&str], out: &Path) {
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "--size",
+        "256x256",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    assert_clean(&voxcone(&args));
+}

@@ -1,7 +1,9 @@
 #version 460
 // One level of the dense grid's anisotropic mip chain (gi/filter/anisotropic.glsl). The
 // first level reads the isotropic base; the six directions sit side by side along x,
-// direction d's cube at x offset d * edge.
+// direction d's cube of edge `edge` in the middle of a slot 2 * edge wide, starting at
+// x = (2d + 1/2) * edge. The voxel just outside each x face repeats the face's voxel:
+// trilinear filtering reads no further (gi/sampling.glsl).
 #include "gpu_layout.glsl"
 #include "gi/filter/anisotropic.glsl"
 
@@ -19,7 +21,7 @@ vec4 load(ivec3 child, int d, int child_edge) {
     if (level == 0u) {
         return facing(imageLoad(voxel_normal, child).r, imageLoad(base_level, child), d);
     }
-    return imageLoad(src, child + ivec3(d * child_edge, 0, 0));
+    return imageLoad(src, child + ivec3((4 * d + 1) * child_edge / 2, 0, 0));
 }
 
 void main() {
@@ -34,6 +36,14 @@ void main() {
         for (int i = 0; i < 8; i++) {
             children[i] = load(first + ivec3(i & 1, (i >> 1) & 1, i >> 2), d, edge * 2);
         }
-        imageStore(dst, parent + ivec3(d * edge, 0, 0), filter_children(children, d));
+        vec4 value = filter_children(children, d);
+        ivec3 at = parent + ivec3((4 * d + 1) * edge / 2, 0, 0);
+        imageStore(dst, at, value);
+        if (parent.x == 0) {
+            imageStore(dst, at - ivec3(1, 0, 0), value);
+        }
+        if (parent.x == edge - 1) {
+            imageStore(dst, at + ivec3(1, 0, 0), value);
+        }
     }
 }

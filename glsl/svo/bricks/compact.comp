@@ -1,13 +1,18 @@
 #version 460
-// Lists the occupied leaf voxels (those with fragments), with their leaf's brick, so that
-// voxel shading and bounces run one invocation per voxel, dispatched indirectly from the
-// list's head as in the dense grid (gi/compact/compact.comp).
+// Per leaf: each voxel's fragment sums (fill.comp) become its mean albedo, normal and
+// emission in the leaf attribute bricks (RGBA8, alpha the fragment count up to 255, as
+// the dense grid stores them; zero for a voxel without fragments), and the occupied
+// voxels are listed with their leaf's brick, so that voxel shading and bounces run one
+// invocation per voxel, dispatched indirectly from the list's head as in the dense grid
+// (gi/compact/compact.comp).
 #define VOXELS_SVO
 #define VOXEL_LIST_WRITER
 #include "svo/octree/level.glsl"
 #include "gi/voxel_list.glsl"
 
-layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform readonly uimage3D leaf_albedo;
+layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform writeonly uimage3D leaf_albedo;
+layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform writeonly uimage3D leaf_normal;
+layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform writeonly uimage3D leaf_emission;
 
 void main() {
     uint node;
@@ -19,7 +24,18 @@ void main() {
     ivec3 first = ivec3(unpack_coord(node_coords[node])) * 2;
     for (int i = 0; i < 8; i++) {
         ivec3 k = ivec3(i & 1, (i >> 1) & 1, i >> 2);
-        if ((imageLoad(leaf_albedo, origin + k).r >> 24) == 0u) {
+        uint base = leaf_sum_base(brick, uvec3(k));
+        uint count = leaf_sums[base + 9u];
+        vec3 mean[3];
+        for (uint a = 0u; a < 3u; a++) {
+            uvec3 sum = uvec3(leaf_sums[base + 3u * a], leaf_sums[base + 3u * a + 1u], leaf_sums[base + 3u * a + 2u]);
+            mean[a] = vec3(sum) / float(max(count, 1u));
+        }
+        float weight = float(min(count, 255u));
+        imageStore(leaf_albedo, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[0], weight))));
+        imageStore(leaf_normal, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[1], weight))));
+        imageStore(leaf_emission, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[2], weight))));
+        if (count == 0u) {
             continue;
         }
         uint index = atomicAdd(list.count, 1u);

@@ -1,18 +1,13 @@
 #version 460
-// Each voxel fragment adds its albedo, normal and emission to its voxel in its leaf's
-// brick, as RGBA8 moving averages (Dřínovský 2013, 5.4.1). A leaf brick holds the leaf's
-// 2x2x2 voxels of the effective grid, voxel (v & 1) of the brick.
-#include "gi/average.glsl"
+// Each voxel fragment adds its albedo, normal and emission (0..255 per channel) and a
+// count to its voxel's sums (Dřínovský 2013, 5.4.1). Integer atomic adds are exact and
+// commutative, so the averages that compact.comp takes do not depend on the order in
+// which the fragments were listed (a running average would, and the list's order
+// changes from build to build). A leaf brick holds the leaf's 2x2x2 voxels of the
+// effective grid, voxel (v & 1) of the brick.
 #include "svo/octree.glsl"
 
 layout(local_size_x = SVO_GROUP_SIZE) in;
-layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform coherent volatile uimage3D brick_albedo;
-layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform coherent volatile uimage3D brick_normal;
-layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform coherent volatile uimage3D brick_emission;
-
-DEFINE_AVERAGE(average_albedo, brick_albedo)
-DEFINE_AVERAGE(average_normal, brick_normal)
-DEFINE_AVERAGE(average_emission, brick_emission)
 
 void main() {
     uint index = gl_GlobalInvocationID.x;
@@ -25,8 +20,12 @@ void main() {
     if (leaf == SVO_NO_NODE || node_bricks[leaf] == SVO_NO_BRICK) {
         return;
     }
-    ivec3 texel = brick_origin(node_bricks[leaf], counters.leaf_pool_side, SVO_ATTRIBUTE_BRICK) + ivec3(v & 1u);
-    average_albedo(texel, unpack_rgba8(f.albedo).rgb);
-    average_normal(texel, unpack_rgba8(f.normal).rgb);
-    average_emission(texel, unpack_rgba8(f.emission).rgb);
+    uint base = leaf_sum_base(node_bricks[leaf], v);
+    uint words[3] = uint[3](f.albedo, f.normal, f.emission);
+    for (uint a = 0u; a < 3u; a++) {
+        for (uint c = 0u; c < 3u; c++) {
+            atomicAdd(leaf_sums[base + 3u * a + c], (words[a] >> (8u * c)) & 0xffu);
+        }
+    }
+    atomicAdd(leaf_sums[base + 9u], 1u);
 }

@@ -1,0 +1,68 @@
+//! Test support: a validating context and renderers that run frames offscreen.
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use crate::frontend::{Offscreen, LDR_FORMAT};
+use crate::gi::{ConeSettings, VoxelStructure};
+use crate::renderer::{GiSettings, OutputTarget, RenderSettings, Renderer};
+use crate::scene::Scene;
+use crate::vk::{Context, ContextOptions, ImageUse};
+
+/// GI settings with default cones at `voxels` per axis.
+pub fn gi_settings(voxels: u32, structure: VoxelStructure, full_update: bool) -> RenderSettings {
+    RenderSettings {
+        gi: Some(GiSettings {
+            voxels,
+            structure,
+            cones: ConeSettings::default(),
+            shadow_cones: false,
+            full_update,
+        }),
+        ..Default::default()
+    }
+}
+
+/// Renders 64x64 frames of `scene`, one at each of `times`, with validation on (its
+/// messages go to the log, shown when a test fails; callers check the count).
+pub fn render_frames(
+    scene: Scene,
+    settings: RenderSettings,
+    times: &[f32],
+) -> (Arc<Context>, Renderer) {
+    let _ = env_logger::builder().is_test(true).try_init();
+    let ctx = Context::new(&ContextOptions {
+        validation: true,
+        ..Default::default()
+    })
+    .unwrap();
+    let extent = vk::Extent2D {
+        width: 64,
+        height: 64,
+    };
+    let offscreen = Offscreen::new(&ctx, extent).unwrap();
+    let mut renderer = Renderer::new(&ctx, scene, settings, extent, LDR_FORMAT).unwrap();
+    let target = OutputTarget {
+        image: offscreen.image.raw,
+        view: offscreen.image.view,
+        extent,
+        before: ImageUse::UNDEFINED,
+        after: ImageUse::COLOR_ATTACHMENT,
+    };
+    for (i, &time) in times.iter().enumerate() {
+        let target = OutputTarget {
+            before: if i == 0 {
+                ImageUse::UNDEFINED
+            } else {
+                ImageUse::discard_after(ImageUse::COLOR_ATTACHMENT)
+            },
+            ..target
+        };
+        let frame = renderer.begin_frame().unwrap();
+        renderer.record_frame(&frame, time, &target).unwrap();
+        renderer.submit(frame, None, None).unwrap();
+    }
+    renderer.finish().unwrap();
+    (ctx, renderer)
+}
