@@ -102,9 +102,11 @@ gpu_layout! {
         /// the dense grid holds volumes): `SvoCounters` then `SvoLevel[SVO_MAX_LEVELS]`,
         /// storage buffer.
         BINDING_SVO_COUNTERS = 20;
-        /// SVO passes (set 2): the voxel-fragment list, `VoxelFragment[]` storage buffer.
+        /// SVO passes (set 2): the voxel-fragment list, first half: per fragment its voxel (x | y << 10 | z << 20) and RGBA8 albedo, `uvec2[]` storage buffer. (Two halves of 8 bytes, so that each fits the 128 MiB that lavapipe binds at depth 9.)
         BINDING_SVO_FRAGMENTS = 21;
-        /// SVO passes (set 2): per node, its first child (children come in tiles of 8; 0 = none) with `SVO_SUBDIVIDE` set while flagged, `uint[]` storage buffer.
+        /// SVO passes (set 2): the voxel-fragment list, second half: per fragment its RGBA8 normal (xyz * 0.5 + 0.5) and emission / `GiUniforms.emission_range`, `uvec2[]` storage buffer.
+        BINDING_SVO_FRAGMENT_SHADING = 28;
+        /// SVO passes (set 2): per node, its first child (children come in tiles of 8; 0 = none) with `SVO_SUBDIVIDE` set while flagged; for a leaf, which of its 8 voxels hold fragments (bits 0-7, voxel x | y << 1 | z << 2) and the first of their sums (bits 8-30), `uint[]` storage buffer.
         BINDING_SVO_NODES = 22;
         /// SVO passes (set 2): per node, its coordinates among its level's nodes (x | y << 10 | z << 20), `uint[]` storage buffer.
         BINDING_SVO_NODE_COORDS = 23;
@@ -114,7 +116,7 @@ gpu_layout! {
         BINDING_SVO_NEIGHBOURS = 25;
         /// SVO passes (set 2): the interior bricks' six directional radiances, `rgba16f` storage (sampled at `BINDING_GI_DIRECTIONAL`).
         BINDING_SVO_DIRECTIONAL_STORAGE = 26;
-        /// SVO passes (set 2): per leaf voxel, the sums of its fragments' albedo, normal and emission (RGB, 0..255 each) and their count, `SVO_SUM_WORDS` words of a `uint[]` storage buffer: atomic adds are exact and commutative, so the averages do not depend on the order the fragments were listed in.
+        /// SVO passes (set 2): per occupied leaf voxel, the sums of its fragments' albedo, normal and emission (RGB, 0..255 each) and their count, `SVO_SUM_WORDS` words of a `uint[]` storage buffer: atomic adds are exact and commutative, so the averages do not depend on the order the fragments were listed in.
         BINDING_SVO_SUMS = 27;
         /// Words per leaf voxel in the sums buffer.
         SVO_SUM_WORDS = 10;
@@ -140,6 +142,8 @@ gpu_layout! {
         SVO_OVERFLOW_LEAF_BRICKS = 4;
         /// `SvoCounters.overflow` bit: the interior brick pool was too small.
         SVO_OVERFLOW_INTERIOR_BRICKS = 8;
+        /// `SvoCounters.overflow` bit: the leaf voxels' sums buffer was too small.
+        SVO_OVERFLOW_LEAF_VOXELS = 16;
 
         /// `GpuLight.kind`: point light, intensity in W/sr.
         LIGHT_POINT = 0;
@@ -340,10 +344,10 @@ gpu_layout! {
         uint leaf_pool_side,
         /// Bricks per row and per column of the interior pool image.
         uint interior_pool_side,
-        /// Unused.
-        uint pad0,
-        /// Unused.
-        uint pad1,
+        /// Occupied leaf voxels given sums (of their fragments' attributes).
+        uint leaf_voxels,
+        /// Leaf voxels the sums buffer holds.
+        uint leaf_voxel_capacity,
     }
 
     /// One level of the octree: its nodes are contiguous in the node pool.
@@ -364,18 +368,6 @@ gpu_layout! {
         uint pad1,
         /// Unused.
         uint pad2,
-    }
-
-    /// One voxel fragment: a triangle's sample of one voxel of the effective grid.
-    struct VoxelFragment {
-        /// Voxel coordinates x | y << 10 | z << 20.
-        uint position,
-        /// RGBA8 albedo (a = 255).
-        uint albedo,
-        /// RGBA8 normal, xyz * 0.5 + 0.5.
-        uint normal,
-        /// RGBA8 emission / `GiUniforms.emission_range`.
-        uint emission,
     }
 
     /// Push constants of the octree passes that work on one level.

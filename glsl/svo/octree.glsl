@@ -10,8 +10,13 @@ layout(set = SET_PASS, binding = BINDING_SVO_COUNTERS, std430) buffer CountersBl
     SvoCounters counters;
     SvoLevel levels[SVO_MAX_LEVELS];
 };
+// Fragment i: its voxel and albedo in fragment_voxels[i], normal and emission in
+// fragment_shading[i].
 layout(set = SET_PASS, binding = BINDING_SVO_FRAGMENTS, std430) buffer FragmentsBlock {
-    VoxelFragment fragments[];
+    uvec2 fragment_voxels[];
+};
+layout(set = SET_PASS, binding = BINDING_SVO_FRAGMENT_SHADING, std430) buffer ShadingBlock {
+    uvec2 fragment_shading[];
 };
 layout(set = SET_PASS, binding = BINDING_SVO_NODES, std430) buffer NodesBlock {
     uint node_children[];
@@ -64,10 +69,17 @@ uint find_node(uvec3 v, uint level) {
     return node;
 }
 
-// The first word of voxel v's sums in leaf brick `brick`.
-uint leaf_sum_base(uint brick, uvec3 v) {
+// Which of its leaf's 8 voxels voxel v is (x | y << 1 | z << 2).
+uint leaf_octant(uvec3 v) {
     uvec3 k = v & 1u;
-    return SVO_SUM_WORDS * (8u * brick + (k.x | (k.y << 1) | (k.z << 2)));
+    return k.x | (k.y << 1) | (k.z << 2);
+}
+
+// The first word of the sums of voxel `octant` of a leaf whose child entry is `entry`
+// (its occupied voxels' mask and first sum); the voxel must be occupied.
+uint leaf_sum_base(uint entry, uint octant) {
+    uint before = bitCount(entry & ((1u << octant) - 1u) & 0xffu);
+    return SVO_SUM_WORDS * (((entry & SVO_CHILD_MASK) >> 8) + uint(before));
 }
 
 // The corner texel of brick `slot` in a pool of `side`³ bricks of `edge`³ texels.

@@ -20,7 +20,7 @@ use gpu_allocator::MemoryLocation;
 
 use crate::gi::voxelize::{Meshes, VoxelizePass};
 use crate::gi::{compute_to_compute, Grid};
-use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel, VoxelFragment, VoxelListHeader};
+use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel, VoxelListHeader};
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
@@ -50,14 +50,16 @@ pub struct Capacities {
     pub nodes: u32,
     pub leaf_bricks: u32,
     pub interior_bricks: u32,
+    /// Occupied leaf voxels (their fragments' sums).
+    pub leaf_voxels: u32,
 }
 
 impl Capacities {
-    /// A first guess from the scene's surface area: a surface covers about 1.5 voxels
-    /// per voxel face of area (dilation, slopes) and two fragments per voxel (overlapping
-    /// triangles, both sides of thin walls); the octree allocates about 0.7 nodes per
-    /// surface voxel (tiles of 8 children under nodes that hold a quarter of their
-    /// children's voxels). Wrong guesses cost a rebuild, not a wrong image.
+    /// A first guess of the fragments from the scene's surface area (about three per
+    /// voxel face of area: dilation, slopes, overlapping triangles), and of the octree's
+    /// pools from that: small, since the octree's counters keep counting past a full pool,
+    /// so one regrowth sizes a pool exactly. Wrong guesses cost a rebuild of the octree
+    /// (not of the fragments), never a wrong image.
     pub fn estimate(scene: &Scene, grid: &Grid) -> Self {
         let mut area = 0.0f64;
         let mut triangles = 0u64;
@@ -72,25 +74,34 @@ impl Capacities {
             }
         }
         let face = f64::from(grid.voxel_size).powi(2);
-        let voxels = (1.5 * area / face + 2.0 * triangles as f64)
-            .min(f64::from(grid.resolution).powi(3))
-            .max(4096.0);
-        let count = |x: f64| x.min(f64::from(u32::MAX / 2)) as u32;
+        let fragments = (3.0 * area / face + 2.0 * triangles as f64).max(4096.0);
+        Self::for_fragments(fragments.min(f64::from(u32::MAX / 2)) as u32)
+    }
+
+    /// The octree's pools for `fragments` fragments: a quarter of what a surface would
+    /// need if every fragment were a voxel of its own.
+    fn for_fragments(fragments: u32) -> Self {
         Self {
-            fragments: count(2.0 * voxels),
-            nodes: count(0.7 * voxels),
-            leaf_bricks: count(0.35 * voxels),
-            interior_bricks: count(0.1 * voxels),
+            fragments,
+            nodes: fragments / 16 + 64,
+            leaf_bricks: fragments / 64 + 16,
+            interior_bricks: fragments / 256 + 16,
+            leaf_voxels: fragments / 16 + 16,
         }
     }
 
-    /// Capacities for another build after `counters` reported an overflow: what the
-    /// full pools needed with a margin, and at least four times the capacity that failed
-    /// (what they report is a lower bound when a pool they depend on ran out too).
+    /// Capacities for another build after `counters` reported an overflow. The counters
+    /// count past a full pool, so what a pool needed is exact when the pools it depends
+    /// on did not overflow too (the fragments depend on nothing; the bricks on the node
+    /// pool); it gets that with a margin. The node pool's count is exact only up to the
+    /// level that ran out: it gets at least four times as much.
     fn grown(&self, counters: &SvoCounters) -> Self {
-        let grow = |capacity: u32, used: u32, bit: u32| {
+        let nodes_short = counters.overflow & layout::SVO_OVERFLOW_NODES != 0;
+        let grow = |capacity: u32, used: u32, bit: u32, exact: bool| {
             if counters.overflow & bit == 0 {
                 capacity
+            } else if exact {
+                used.saturating_add(used / 8).saturating_add(16)
             } else {
                 capacity
                     .saturating_mul(4)
@@ -102,17 +113,31 @@ impl Capacities {
                 self.fragments,
                 counters.fragment_count,
                 layout::SVO_OVERFLOW_FRAGMENTS,
+                true,
             ),
-            nodes: grow(self.nodes, counters.node_count, layout::SVO_OVERFLOW_NODES),
+            nodes: grow(
+                self.nodes,
+                counters.node_count,
+                layout::SVO_OVERFLOW_NODES,
+                false,
+            ),
             leaf_bricks: grow(
                 self.leaf_bricks,
                 counters.leaf_bricks,
                 layout::SVO_OVERFLOW_LEAF_BRICKS,
+                !nodes_short,
             ),
             interior_bricks: grow(
                 self.interior_bricks,
                 counters.interior_bricks,
                 layout::SVO_OVERFLOW_INTERIOR_BRICKS,
+                !nodes_short,
+            ),
+            leaf_voxels: grow(
+                self.leaf_voxels,
+                counters.leaf_voxels,
+                layout::SVO_OVERFLOW_LEAF_VOXELS,
+                !nodes_short,
             ),
         }
     }
@@ -145,6 +170,12 @@ fn overflowed(counters: &SvoCounters, capacities: &Capacities) -> Vec<String> {
             counters.interior_bricks,
             capacities.interior_bricks,
         ),
+        (
+            layout::SVO_OVERFLOW_LEAF_VOXELS,
+            "leaf voxel sums",
+            counters.leaf_voxels,
+            capacities.leaf_voxels,
+        ),
     ];
     pools
         .iter()
@@ -167,9 +198,6 @@ fn pool_side(bricks: u32) -> u32 {
 /// The octree's pools on the GPU.
 struct Pools {
     capacities: Capacities,
-    /// `SvoCounters`, then `SvoLevel[SVO_MAX_LEVELS]`; also the indirect dispatches.
-    counters: Buffer,
-    fragments: Buffer,
     nodes: Buffer,
     coords: Buffer,
     bricks: Buffer,
@@ -255,16 +283,6 @@ impl Pools {
             2 * u64::from(layout::SVO_ATTRIBUTE_BRICK).pow(3) * u64::from(capacities.leaf_bricks);
         Ok(Self {
             capacities,
-            counters: buffer(
-                "svo counters",
-                COUNTERS_BYTES as u64,
-                vk::BufferUsageFlags::INDIRECT_BUFFER,
-            )?,
-            fragments: buffer(
-                "svo fragments",
-                u64::from(capacities.fragments) * std::mem::size_of::<VoxelFragment>() as u64,
-                vk::BufferUsageFlags::empty(),
-            )?,
             nodes: buffer("svo nodes", 4 * nodes, vk::BufferUsageFlags::empty())?,
             coords: buffer("svo node coords", 4 * nodes, vk::BufferUsageFlags::empty())?,
             bricks: buffer("svo node bricks", 4 * nodes, vk::BufferUsageFlags::empty())?,
@@ -291,9 +309,7 @@ impl Pools {
             )?,
             sums: buffer(
                 "svo fragment sums",
-                4 * u64::from(layout::SVO_SUM_WORDS)
-                    * u64::from(layout::SVO_ATTRIBUTE_BRICK).pow(3)
-                    * u64::from(capacities.leaf_bricks),
+                4 * u64::from(layout::SVO_SUM_WORDS) * u64::from(capacities.leaf_voxels),
                 vk::BufferUsageFlags::empty(),
             )?,
         })
@@ -305,8 +321,6 @@ impl Pools {
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         let [albedo, normal, emission] = &self.leaf_attributes;
         SetWriter::new(ctx, set)
-            .buffer(layout::BINDING_SVO_COUNTERS, storage, self.counters.raw)
-            .buffer(layout::BINDING_SVO_FRAGMENTS, storage, self.fragments.raw)
             .buffer(layout::BINDING_SVO_NODES, storage, self.nodes.raw)
             .buffer(layout::BINDING_SVO_NODE_COORDS, storage, self.coords.raw)
             .buffer(layout::BINDING_SVO_NODE_BRICKS, storage, self.bricks.raw)
@@ -345,7 +359,6 @@ impl Pools {
             .map(Image::memory_bytes)
             .sum();
         vec![
-            ("svo_fragments", self.fragments.size),
             (
                 "svo_node_pool",
                 self.nodes.size + self.coords.size + self.bricks.size + self.neighbours.size,
@@ -353,8 +366,46 @@ impl Pools {
             ("svo_brick_pool", bricks),
             ("svo_voxel_list", self.voxel_list.size),
             ("svo_fragment_sums", self.sums.size),
-            ("svo_counters", self.counters.size),
         ]
+    }
+}
+
+/// The voxel-fragment list, in two halves of 8 bytes per fragment.
+struct Fragments {
+    capacity: u32,
+    voxels: Buffer,
+    shading: Buffer,
+}
+
+impl Fragments {
+    fn new(ctx: &Arc<Context>, capacity: u32) -> Result<Self> {
+        let bytes = 8 * u64::from(capacity);
+        let limit = u64::from(ctx.properties.limits.max_storage_buffer_range);
+        ensure!(
+            bytes <= limit,
+            "the SVO voxel-fragment list needs 2 x {bytes} bytes for {capacity} fragments, \
+             more than the device's largest storage buffer ({limit} bytes): use a smaller \
+             --octree-depth"
+        );
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC;
+        let buffer = |name| Buffer::new(ctx, name, bytes, usage, MemoryLocation::GpuOnly);
+        Ok(Self {
+            capacity,
+            voxels: buffer("svo fragment voxels")?,
+            shading: buffer("svo fragment shading")?,
+        })
+    }
+
+    fn write_set(&self, ctx: &Context, set: vk::DescriptorSet) {
+        let storage = vk::DescriptorType::STORAGE_BUFFER;
+        SetWriter::new(ctx, set)
+            .buffer(layout::BINDING_SVO_FRAGMENTS, storage, self.voxels.raw)
+            .buffer(
+                layout::BINDING_SVO_FRAGMENT_SHADING,
+                storage,
+                self.shading.raw,
+            )
+            .apply();
     }
 }
 
@@ -394,6 +445,11 @@ impl BuildReport {
                 f64::from(capacities.leaf_bricks),
             ),
             ("interior_bricks".to_string(), f64::from(c.interior_bricks)),
+            ("leaf_voxels".to_string(), f64::from(c.leaf_voxels)),
+            (
+                "leaf_voxel_capacity".to_string(),
+                f64::from(capacities.leaf_voxels),
+            ),
             (
                 "interior_brick_capacity".to_string(),
                 f64::from(capacities.interior_bricks),
@@ -422,6 +478,7 @@ pub fn bindings() -> Vec<Binding> {
     vec![
         Binding::new(layout::BINDING_SVO_COUNTERS, storage, all),
         Binding::new(layout::BINDING_SVO_FRAGMENTS, storage, all),
+        Binding::new(layout::BINDING_SVO_FRAGMENT_SHADING, storage, all),
         Binding::new(layout::BINDING_SVO_NODES, storage, all),
         Binding::new(layout::BINDING_SVO_NODE_COORDS, storage, all),
         Binding::new(layout::BINDING_SVO_NODE_BRICKS, storage, all),
@@ -440,8 +497,11 @@ pub struct SvoGi {
     /// The effective grid: 2^depth voxels per axis over the dense path's cube.
     pub grid: Grid,
     pub depth: u32,
+    /// `SvoCounters`, then `SvoLevel[SVO_MAX_LEVELS]`; also the indirect dispatches.
+    counters: Buffer,
+    fragments: Fragments,
     pools: Pools,
-    fragments: VoxelizePass,
+    voxelize: VoxelizePass,
     octree: octree::OctreePasses,
     bricks: bricks::BrickPasses,
     report: Option<BuildReport>,
@@ -466,13 +526,34 @@ impl SvoGi {
         check_depth(depth)?;
         let grid = Grid::around(scene, 1 << depth);
         let capacities = capacities.unwrap_or_else(|| Capacities::estimate(scene, &grid));
+        let counters = Buffer::new(
+            ctx,
+            "svo counters",
+            COUNTERS_BYTES as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER
+                | vk::BufferUsageFlags::INDIRECT_BUFFER
+                | vk::BufferUsageFlags::TRANSFER_SRC
+                | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?;
+        SetWriter::new(ctx, set)
+            .buffer(
+                layout::BINDING_SVO_COUNTERS,
+                vk::DescriptorType::STORAGE_BUFFER,
+                counters.raw,
+            )
+            .apply();
+        let fragments = Fragments::new(ctx, capacities.fragments)?;
+        fragments.write_set(ctx, set);
         let pools = Pools::new(ctx, capacities)?;
         pools.write_set(ctx, set, linear);
         Ok(Self {
             grid,
             depth,
+            counters,
+            fragments,
             pools,
-            fragments: VoxelizePass::new(
+            voxelize: VoxelizePass::new(
                 ctx,
                 "svo fragments",
                 crate::vk::shaders::SVO_FRAGMENTS_FRAGMENTS_FRAG,
@@ -501,7 +582,7 @@ impl SvoGi {
     ) {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, set)];
         self.bricks
-            .record_filter(&self.ctx, cmd, &sets, self.pools.counters.raw, self.depth);
+            .record_filter(&self.ctx, cmd, &sets, self.counters.raw, self.depth);
     }
 
     /// The last build's report.
@@ -515,69 +596,107 @@ impl SvoGi {
 
     /// GPU memory of every octree resource, by name.
     pub fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
-        self.pools.bytes()
+        let mut bytes = vec![
+            (
+                "svo_fragments",
+                self.fragments.voxels.size + self.fragments.shading.size,
+            ),
+            ("svo_counters", self.counters.size),
+        ];
+        bytes.extend(self.pools.bytes());
+        bytes
     }
 
-    /// Builds the octree of the meshes at `draw.time_s` and waits for it. A pool that
-    /// overflows is reported (a warning, and in the report), grown and the build runs
-    /// again.
+    /// Builds the octree of the meshes at `draw.time_s` and waits for it: the voxel
+    /// fragments, then the octree and its bricks from them. A pool that overflows is
+    /// reported (a warning, and in the report), grown, and its phase runs again.
     pub fn build(&mut self, draw: &SceneDraw, set: vk::DescriptorSet) -> Result<&BuildReport> {
         let start = Instant::now();
         let mut regrowths = Vec::new();
-        loop {
-            let mut timer = GpuTimer::new(&self.ctx)?;
-            let readback = Buffer::new(
-                &self.ctx,
-                "svo counters readback",
-                COUNTERS_BYTES as u64,
-                vk::BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuToCpu,
-            )?;
-            OneShot::new(&self.ctx)?.run("svo build", |cmd| {
-                timer.reset(cmd);
-                self.record_build(cmd, &mut timer, draw, set);
-                self.copy_counters(cmd, readback.raw);
-                Ok(())
-            })?;
-            let bytes = readback.mapped();
-            let counters: SvoCounters =
-                bytemuck::pod_read_unaligned(&bytes[..std::mem::size_of::<SvoCounters>()]);
-            if counters.overflow == 0 {
-                let levels = bytes[std::mem::size_of::<SvoCounters>()..COUNTERS_BYTES]
-                    .chunks_exact(std::mem::size_of::<SvoLevel>())
-                    .take(self.depth as usize)
-                    .map(bytemuck::pod_read_unaligned)
-                    .collect();
-                self.report = Some(BuildReport {
-                    counters,
-                    levels,
-                    passes: timer.results()?,
-                    regrowths,
-                    wall_ms: start.elapsed().as_secs_f64() * 1e3,
-                });
-                return Ok(self.report.as_ref().unwrap());
+        let mut passes = Vec::new();
+        for phase in [Phase::Fragments, Phase::Octree] {
+            loop {
+                let (counters, levels, timings) = self.run(phase, draw, set)?;
+                if counters.overflow == 0 {
+                    passes.extend(timings);
+                    if phase == Phase::Octree {
+                        self.report = Some(BuildReport {
+                            counters,
+                            levels,
+                            passes,
+                            regrowths,
+                            wall_ms: start.elapsed().as_secs_f64() * 1e3,
+                        });
+                        return Ok(self.report.as_ref().unwrap());
+                    }
+                    break;
+                }
+                let capacities = self.pools.capacities;
+                let grown = capacities.grown(&counters);
+                let message = format!(
+                    "SVO pools too small ({}); growing them and building again",
+                    overflowed(&counters, &capacities).join("; ")
+                );
+                log::warn!("{message}");
+                regrowths.push(message);
+                ensure!(
+                    regrowths.len() < 8,
+                    "the SVO build still overflows after {} regrowths",
+                    regrowths.len()
+                );
+                if phase == Phase::Fragments {
+                    self.fragments = Fragments::new(&self.ctx, grown.fragments)
+                        .context("growing the voxel-fragment list")?;
+                    self.fragments.write_set(&self.ctx, set);
+                    self.pools.capacities.fragments = grown.fragments;
+                } else {
+                    self.pools = Pools::new(&self.ctx, grown).context("growing the SVO pools")?;
+                    self.pools.write_set(&self.ctx, set, self.linear);
+                }
             }
-            let capacities = self.pools.capacities;
-            let grown = capacities.grown(&counters);
-            let message = format!(
-                "SVO pools too small ({}); growing them and building again",
-                overflowed(&counters, &capacities).join("; ")
-            );
-            log::warn!("{message}");
-            regrowths.push(message);
-            ensure!(
-                regrowths.len() < 8,
-                "the SVO build still overflows after {} regrowths",
-                regrowths.len()
-            );
-            self.pools = Pools::new(&self.ctx, grown).context("growing the SVO pools")?;
-            self.pools.write_set(&self.ctx, set, self.linear);
         }
+        unreachable!("the octree phase returns")
     }
 
-    /// Records the whole build: counters reset, fragments, octree, leaf bricks, the list
-    /// of occupied leaf voxels, and cleared radiance pools.
-    fn record_build(
+    /// Runs one phase of the build and waits for it; returns the counters, the level
+    /// table's first `depth` rows and the phase's GPU time per pass.
+    #[allow(clippy::type_complexity)]
+    fn run(
+        &self,
+        phase: Phase,
+        draw: &SceneDraw,
+        set: vk::DescriptorSet,
+    ) -> Result<(SvoCounters, Vec<SvoLevel>, Vec<(String, f64)>)> {
+        let mut timer = GpuTimer::new(&self.ctx)?;
+        let readback = Buffer::new(
+            &self.ctx,
+            "svo counters readback",
+            COUNTERS_BYTES as u64,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        OneShot::new(&self.ctx)?.run("svo build", |cmd| {
+            timer.reset(cmd);
+            match phase {
+                Phase::Fragments => self.record_fragments(cmd, &mut timer, draw, set),
+                Phase::Octree => self.record_octree(cmd, &mut timer, draw.frame_set, set),
+            }
+            self.copy_counters(cmd, readback.raw);
+            Ok(())
+        })?;
+        let bytes = readback.mapped();
+        let head = std::mem::size_of::<SvoCounters>();
+        let counters = bytemuck::pod_read_unaligned(&bytes[..head]);
+        let levels = bytes[head..COUNTERS_BYTES]
+            .chunks_exact(std::mem::size_of::<SvoLevel>())
+            .take(self.depth as usize)
+            .map(bytemuck::pod_read_unaligned)
+            .collect();
+        Ok((counters, levels, timer.results()?))
+    }
+
+    /// Records the first phase: the counters reset, then the voxel fragments.
+    fn record_fragments(
         &self,
         cmd: vk::CommandBuffer,
         timer: &mut GpuTimer,
@@ -585,12 +704,60 @@ impl SvoGi {
         set: vk::DescriptorSet,
     ) {
         let ctx = &self.ctx;
-        let p = &self.pools;
-        let c = &p.capacities;
         let counters = SvoCounters {
             fragment_groups_y: 1,
             fragment_groups_z: 1,
-            fragment_capacity: c.fragments,
+            fragment_capacity: self.fragments.capacity,
+            ..Default::default()
+        };
+        unsafe {
+            ctx.device
+                .cmd_update_buffer(cmd, self.counters.raw, 0, bytemuck::bytes_of(&counters))
+        };
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE,
+            ),
+        );
+        timer.begin(cmd, "fragments");
+        self.voxelize
+            .record(ctx, cmd, draw, set, self.grid.resolution, Meshes::All);
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                vk::AccessFlags2::SHADER_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::TRANSFER_READ,
+            ),
+        );
+        timer.end(cmd);
+    }
+
+    /// Records the second phase, from the fragments: the octree's counters reset, the
+    /// octree, leaf bricks, the list of occupied leaf voxels, and cleared radiance pools.
+    fn record_octree(
+        &self,
+        cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
+        frame_set: vk::DescriptorSet,
+        set: vk::DescriptorSet,
+    ) {
+        let ctx = &self.ctx;
+        let p = &self.pools;
+        let c = &p.capacities;
+        // From `node_count` on: the fragments' counters stay.
+        let counters = SvoCounters {
             // The root.
             node_count: 1,
             node_capacity: c.nodes,
@@ -598,6 +765,7 @@ impl SvoGi {
             interior_brick_capacity: c.interior_bricks,
             leaf_pool_side: p.leaf_side,
             interior_pool_side: p.interior_side,
+            leaf_voxel_capacity: c.leaf_voxels,
             ..Default::default()
         };
         let root = SvoLevel {
@@ -608,10 +776,24 @@ impl SvoGi {
             count: 1,
             ..Default::default()
         };
-        let mut head = bytemuck::bytes_of(&counters).to_vec();
+        let from = std::mem::offset_of!(SvoCounters, node_count);
+        let mut head = bytemuck::bytes_of(&counters)[from..].to_vec();
         head.extend_from_slice(bytemuck::bytes_of(&root));
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                vk::AccessFlags2::MEMORY_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            ),
+        );
         unsafe {
-            ctx.device.cmd_update_buffer(cmd, p.counters.raw, 0, &head);
+            ctx.device
+                .cmd_update_buffer(cmd, self.counters.raw, from as u64, &head);
             // The root: no children yet, at (0, 0, 0).
             ctx.device.cmd_fill_buffer(cmd, p.nodes.raw, 0, 4, 0);
             ctx.device.cmd_fill_buffer(cmd, p.coords.raw, 0, 4, 0);
@@ -626,43 +808,22 @@ impl SvoGi {
                 vk::AccessFlags2::TRANSFER_WRITE,
             ),
             (
-                vk::PipelineStageFlags2::FRAGMENT_SHADER
-                    | vk::PipelineStageFlags2::COMPUTE_SHADER
-                    | vk::PipelineStageFlags2::DRAW_INDIRECT,
-                vk::AccessFlags2::SHADER_READ
-                    | vk::AccessFlags2::SHADER_WRITE
-                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
-            ),
-        );
-
-        timer.begin(cmd, "fragments");
-        self.fragments
-            .record(ctx, cmd, draw, set, self.grid.resolution, Meshes::All);
-        memory_barrier(
-            ctx,
-            cmd,
-            (
-                vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                vk::AccessFlags2::SHADER_WRITE,
-            ),
-            (
                 vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
                 vk::AccessFlags2::SHADER_READ
                     | vk::AccessFlags2::SHADER_WRITE
                     | vk::AccessFlags2::INDIRECT_COMMAND_READ,
             ),
         );
-        timer.end(cmd);
-
-        let sets = [(layout::SET_FRAME, draw.frame_set), (layout::SET_PASS, set)];
+        let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, set)];
+        let counters = self.counters.raw;
         self.octree
-            .record(ctx, cmd, timer, &sets, p.counters.raw, self.depth);
+            .record(ctx, cmd, timer, &sets, counters, self.depth);
 
         timer.begin(cmd, "brick fill");
         for image in &p.leaf_attributes {
             clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, BRICK_USE);
         }
-        self.bricks.record_fill(cmd, &sets, p.counters.raw);
+        self.bricks.record_fill(cmd, &sets, counters);
         compute_to_compute(ctx, cmd);
         timer.end(cmd);
 
@@ -690,7 +851,7 @@ impl SvoGi {
             ),
         );
         self.bricks
-            .record_list(cmd, &sets, p.counters.raw, self.depth - 1);
+            .record_list(cmd, &sets, counters, self.depth - 1);
         // Voxel shading writes only the listed voxels: the others must read zero.
         for image in [&p.leaf_direct, &p.leaf_radiance, &p.directional] {
             clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, RADIANCE_USE);
@@ -729,10 +890,19 @@ impl SvoGi {
         let region = vk::BufferCopy::default().size(COUNTERS_BYTES as u64);
         unsafe {
             ctx.device
-                .cmd_copy_buffer(cmd, self.pools.counters.raw, to, &[region])
+                .cmd_copy_buffer(cmd, self.counters.raw, to, &[region])
         };
         copies_to_host_barrier(ctx, cmd);
     }
+}
+
+/// The two phases of a build, each run again alone when its pools overflow.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Phase {
+    /// The voxel-fragment list.
+    Fragments,
+    /// The octree, its bricks and the occupied-voxel list, from the fragments.
+    Octree,
 }
 
 /// How the leaf-brick attribute images are used between passes.

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use super::{Capacities, SvoGi};
 use crate::gi::reference;
 use crate::gi::VoxelStructure;
-use crate::gpu_layout::{self as layout, VoxelFragment};
+use crate::gpu_layout as layout;
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
@@ -28,9 +28,17 @@ fn build(scene: Scene, depth: u32, capacities: Option<Capacities>) -> (Arc<Conte
     build_and_render(scene, depth, capacities, 0)
 }
 
+/// A voxel fragment as downloaded.
+struct Fragment {
+    position: u32,
+    albedo: u32,
+    normal: u32,
+    emission: u32,
+}
+
 /// The octree as downloaded.
 struct Downloaded {
-    fragments: Vec<VoxelFragment>,
+    fragments: Vec<Fragment>,
     /// Per level: (first node, count).
     levels: Vec<(u32, u32)>,
     children: Vec<u32>,
@@ -46,10 +54,18 @@ fn unpack(p: u32) -> [u32; 3] {
 fn download(svo: &SvoGi) -> Downloaded {
     let report = svo.report().unwrap();
     let p = &svo.pools;
-    let fragment_words = svo.download_words(&p.fragments).unwrap();
     let stored = report.counters.fragment_count as usize;
+    let voxels = svo.download_words(&svo.fragments.voxels).unwrap();
+    let shading = svo.download_words(&svo.fragments.shading).unwrap();
     Downloaded {
-        fragments: bytemuck::cast_slice(&fragment_words[..4 * stored]).to_vec(),
+        fragments: (0..stored)
+            .map(|i| Fragment {
+                position: voxels[2 * i],
+                albedo: voxels[2 * i + 1],
+                normal: shading[2 * i],
+                emission: shading[2 * i + 1],
+            })
+            .collect(),
         levels: report.levels.iter().map(|l| (l.first, l.count)).collect(),
         children: svo.download_words(&p.nodes).unwrap(),
         coords: svo
@@ -98,6 +114,7 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
 
     let mut by_coords: Vec<HashMap<[u32; 3], u32>> = Vec::new();
     let mut leaf_bricks = HashSet::new();
+    let mut leaf_sums = Vec::new();
     let mut interior_bricks = HashSet::new();
     for (l, &(first, count)) in d.levels.iter().enumerate() {
         let mut map = HashMap::new();
@@ -124,7 +141,19 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
             }
             let tile = d.children[node as usize];
             assert_eq!(tile & layout::SVO_SUBDIVIDE, 0, "flag left set");
-            if occupied && l + 1 < depth as usize {
+            if l + 1 == depth as usize {
+                // A leaf: the mask of its occupied voxels, then the first of their sums.
+                let mask = (0..8u32)
+                    .filter(|o| {
+                        let k = [o & 1, (o >> 1) & 1, o >> 2];
+                        voxels.contains(&std::array::from_fn(|a| 2 * c[a] + k[a]))
+                    })
+                    .fold(0, |m, o| m | 1 << o);
+                assert_eq!(tile & 0xff, mask, "leaf {node}: voxel mask");
+                if mask != 0 {
+                    leaf_sums.push((tile >> 8, mask.count_ones()));
+                }
+            } else if occupied {
                 let (next_first, next_count) = d.levels[l + 1];
                 assert!(
                     tile >= next_first && tile + 8 <= next_first + next_count,
@@ -148,6 +177,15 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
     }
     let counters = svo.report().unwrap().counters;
     assert_eq!(leaf_bricks.len() as u32, counters.leaf_bricks);
+    // The leaves' sums tile the sums buffer without gaps or overlaps.
+    leaf_sums.sort_unstable();
+    let mut next = 0;
+    for (first, count) in &leaf_sums {
+        assert_eq!(*first, next, "leaf sums overlap or leave a gap");
+        next += count;
+    }
+    assert_eq!(next as usize, voxels.len());
+    assert_eq!(counters.leaf_voxels as usize, voxels.len());
     assert_eq!(interior_bricks.len() as u32, counters.interior_bricks);
 
     // Neighbours: the node at the next coordinates of the same level, and symmetric.
@@ -332,6 +370,7 @@ fn tiny_pools_grow_and_rebuild() {
         nodes: 9,
         leaf_bricks: 1,
         interior_bricks: 1,
+        leaf_voxels: 1,
     };
     let (ctx, grown) = build(scene.clone(), 6, Some(tiny));
     let (_, roomy) = build(scene, 6, None);
@@ -343,7 +382,12 @@ fn tiny_pools_grow_and_rebuild() {
     eprintln!("{}", report.regrowths.join("\n"));
     assert!(!report.regrowths.is_empty());
     assert!(report.regrowths[0].contains("voxel-fragment list: 64 entries"));
-    let named = ["node pool", "leaf brick pool", "interior brick pool"];
+    let named = [
+        "node pool",
+        "leaf brick pool",
+        "interior brick pool",
+        "leaf voxel sums",
+    ];
     for pool in named {
         assert!(
             report.regrowths.iter().any(|r| r.contains(pool)),

@@ -24,8 +24,10 @@ void main() {
     ivec3 first = ivec3(unpack_coord(node_coords[node])) * 2;
     for (int i = 0; i < 8; i++) {
         ivec3 k = ivec3(i & 1, (i >> 1) & 1, i >> 2);
-        uint base = leaf_sum_base(brick, uvec3(k));
-        uint count = leaf_sums[base + 9u];
+        uint entry = node_children[node];
+        bool occupied = (entry & (1u << uint(i))) != 0u;
+        uint base = occupied ? leaf_sum_base(entry, uint(i)) : 0u;
+        uint count = occupied ? leaf_sums[base + 9u] : 0u;
         vec3 mean[3];
         for (uint a = 0u; a < 3u; a++) {
             uvec3 sum = uvec3(leaf_sums[base + 3u * a], leaf_sums[base + 3u * a + 1u], leaf_sums[base + 3u * a + 2u]);

@@ -14,14 +14,20 @@ void main() {
     if (index >= min(counters.fragment_count, counters.fragment_capacity)) {
         return;
     }
-    VoxelFragment f = fragments[index];
-    uvec3 v = unpack_coord(f.position);
+    uvec2 at = fragment_voxels[index];
+    uvec2 shading = fragment_shading[index];
+    uvec3 v = unpack_coord(at.x);
     uint leaf = find_node(v, svo_depth() - 1u);
     if (leaf == SVO_NO_NODE || node_bricks[leaf] == SVO_NO_BRICK) {
         return;
     }
-    uint base = leaf_sum_base(node_bricks[leaf], v);
-    uint words[3] = uint[3](f.albedo, f.normal, f.emission);
+    uint entry = node_children[leaf];
+    uint octant = leaf_octant(v);
+    if ((entry & (1u << octant)) == 0u) {
+        return;
+    }
+    uint base = leaf_sum_base(entry, octant);
+    uint words[3] = uint[3](at.y, shading.x, shading.y);
     for (uint a = 0u; a < 3u; a++) {
         for (uint c = 0u; c < 3u; c++) {
             atomicAdd(leaf_sums[base + 3u * a + c], (words[a] >> (8u * c)) & 0xffu);

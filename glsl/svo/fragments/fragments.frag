@@ -12,11 +12,8 @@ void store_voxel(ivec3 voxel, vec3 albedo, vec3 normal, vec3 emission) {
         atomicOr(counters.overflow, SVO_OVERFLOW_FRAGMENTS);
         return;
     }
-    fragments[index] = VoxelFragment(
-        pack_coord(uvec3(voxel)),
-        pack_rgba8(vec4(albedo * 255.0, 255.0)),
-        pack_rgba8(vec4(normal * 255.0, 255.0)),
-        pack_rgba8(vec4(emission * 255.0, 255.0)));
+    fragment_voxels[index] = uvec2(pack_coord(uvec3(voxel)), pack_rgba8(vec4(albedo * 255.0, 255.0)));
+    fragment_shading[index] = uvec2(pack_rgba8(vec4(normal * 255.0, 255.0)), pack_rgba8(vec4(emission * 255.0, 255.0)));
     if (index % SVO_GROUP_SIZE == 0u) {
         atomicMax(counters.fragment_groups_x, index / SVO_GROUP_SIZE + 1u);
     }

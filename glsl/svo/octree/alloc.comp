@@ -1,6 +1,7 @@
 #version 460
 // Each flagged node of `push.level` takes a brick and, above the leaf level, a tile of 8
-// children from the node pool through atomic counters (Crassin & Green 2012). The new
+// children from the node pool through atomic counters (Crassin & Green 2012); a leaf
+// takes the sums of its occupied voxels instead. The new
 // children are all appended in this pass, so each level's nodes are contiguous. A pool
 // that runs out is reported in `counters.overflow`; the host grows it and builds again.
 #include "svo/octree/level.glsl"
@@ -31,7 +32,16 @@ void main() {
     }
     node_bricks[node] = brick;
     if (leaf) {
-        node_children[node] = 0u;
+        uint mask = node_children[node] & 0xffu;
+        uint voxels = uint(bitCount(mask));
+        uint first = atomicAdd(counters.leaf_voxels, voxels);
+        if (first + voxels > counters.leaf_voxel_capacity) {
+            atomicOr(counters.overflow, SVO_OVERFLOW_LEAF_VOXELS);
+            // No voxels: fill.comp skips the leaf (the build runs again).
+            node_children[node] = 0u;
+        } else {
+            node_children[node] = (first << 8) | mask;
+        }
         return;
     }
     uint tile = atomicAdd(counters.node_count, 8u);

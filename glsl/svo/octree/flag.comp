@@ -1,6 +1,7 @@
 #version 460
 // Each voxel fragment descends the octree built so far to its node at `push.level` and
-// flags it for subdivision (at the leaf level: as holding voxels).
+// flags it for subdivision; at the leaf level, it flags the leaf as holding voxels and
+// marks its own voxel in the leaf's mask.
 #include "svo/octree.glsl"
 
 layout(local_size_x = SVO_GROUP_SIZE) in;
@@ -13,13 +14,18 @@ void main() {
     if (index >= min(counters.fragment_count, counters.fragment_capacity)) {
         return;
     }
-    uint node = find_node(unpack_coord(fragments[index].position), push.level);
+    uvec3 v = unpack_coord(fragment_voxels[index].x);
+    uint node = find_node(v, push.level);
     // Every ancestor holds this fragment, so it was subdivided, unless the node pool
     // overflowed (reported; the host builds again with a larger pool).
     if (node == SVO_NO_NODE) {
         return;
     }
-    if ((node_children[node] & SVO_SUBDIVIDE) == 0u) {
-        atomicOr(node_children[node], SVO_SUBDIVIDE);
+    uint bits = SVO_SUBDIVIDE;
+    if (push.level + 1u == svo_depth()) {
+        bits |= 1u << leaf_octant(v);
+    }
+    if ((node_children[node] & bits) != bits) {
+        atomicOr(node_children[node], bits);
     }
 }
