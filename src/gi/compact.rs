@@ -7,7 +7,7 @@ use anyhow::Result;
 use ash::vk;
 
 use crate::gpu_layout::{self as layout, VoxelListHeader};
-use crate::vk::{groups_3d, memory_barrier, Buffer, Context, Pipeline};
+use crate::vk::{groups_3d, memory_barrier, update_buffer, Buffer, Context, Pipeline};
 
 pub struct CompactPass {
     pipeline: Pipeline,
@@ -74,21 +74,13 @@ impl CompactPass {
             groups_z: 1,
             count: 0,
         };
-        unsafe {
-            ctx.device
-                .cmd_update_buffer(cmd, self.list.raw, 0, bytemuck::bytes_of(&empty))
-        };
-        memory_barrier(
+        update_buffer(
             ctx,
             cmd,
-            (
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-                vk::AccessFlags2::TRANSFER_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            ),
+            self.list.raw,
+            0,
+            bytemuck::bytes_of(&empty),
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
         );
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
         self.pipeline

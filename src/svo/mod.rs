@@ -24,8 +24,8 @@ use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel, VoxelListHeader};
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
-    clear_to_zero, copies_to_host_barrier, memory_barrier, Binding, Buffer, Context, GpuTimer,
-    Image, ImageDesc, ImageUse, OneShot, SetWriter,
+    clear_to_zero, copies_to_host_barrier, memory_barrier, update_buffer, Binding, Buffer, Context,
+    GpuTimer, Image, ImageDesc, ImageUse, OneShot, SetWriter,
 };
 
 /// Octree depths `--octree-depth` accepts: effective grids of 64³ to 1024³.
@@ -710,21 +710,13 @@ impl SvoGi {
             fragment_capacity: self.fragments.capacity,
             ..Default::default()
         };
-        unsafe {
-            ctx.device
-                .cmd_update_buffer(cmd, self.counters.raw, 0, bytemuck::bytes_of(&counters))
-        };
-        memory_barrier(
+        update_buffer(
             ctx,
             cmd,
-            (
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-                vk::AccessFlags2::TRANSFER_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE,
-            ),
+            self.counters.raw,
+            0,
+            bytemuck::bytes_of(&counters),
+            vk::PipelineStageFlags2::FRAGMENT_SHADER,
         );
         timer.begin(cmd, "fragments");
         self.voxelize
@@ -834,21 +826,13 @@ impl SvoGi {
             groups_z: 1,
             count: 0,
         };
-        unsafe {
-            ctx.device
-                .cmd_update_buffer(cmd, p.voxel_list.raw, 0, bytemuck::bytes_of(&empty))
-        };
-        memory_barrier(
+        update_buffer(
             ctx,
             cmd,
-            (
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-                vk::AccessFlags2::TRANSFER_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE,
-            ),
+            p.voxel_list.raw,
+            0,
+            bytemuck::bytes_of(&empty),
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
         );
         self.bricks
             .record_list(cmd, &sets, counters, self.depth - 1);

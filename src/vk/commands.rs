@@ -242,6 +242,33 @@ impl Drop for OneShot {
     }
 }
 
+/// Writes `data` (at most 64 KiB) into `buffer` at byte `offset` from the command buffer,
+/// visible to shader reads and writes (and indirect dispatches) in `readers` after it.
+pub fn update_buffer(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    buffer: vk::Buffer,
+    offset: u64,
+    data: &[u8],
+    readers: vk::PipelineStageFlags2,
+) {
+    unsafe { ctx.device.cmd_update_buffer(cmd, buffer, offset, data) };
+    memory_barrier(
+        ctx,
+        cmd,
+        (
+            vk::PipelineStageFlags2::ALL_TRANSFER,
+            vk::AccessFlags2::TRANSFER_WRITE,
+        ),
+        (
+            readers,
+            vk::AccessFlags2::SHADER_READ
+                | vk::AccessFlags2::SHADER_WRITE
+                | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+        ),
+    );
+}
+
 /// Copies `buffer` (written by any earlier shader) to the host and returns its bytes,
 /// once the GPU is done with it.
 pub fn read_back_buffer(ctx: &Arc<Context>, buffer: &Buffer) -> Result<Vec<u8>> {
