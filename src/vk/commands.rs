@@ -253,6 +253,10 @@ pub fn update_buffer(
     readers: vk::PipelineStageFlags2,
 ) {
     unsafe { ctx.device.cmd_update_buffer(cmd, buffer, offset, data) };
+    let mut access = vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE;
+    if readers.contains(vk::PipelineStageFlags2::DRAW_INDIRECT) {
+        access |= vk::AccessFlags2::INDIRECT_COMMAND_READ;
+    }
     memory_barrier(
         ctx,
         cmd,
@@ -260,12 +264,7 @@ pub fn update_buffer(
             vk::PipelineStageFlags2::ALL_TRANSFER,
             vk::AccessFlags2::TRANSFER_WRITE,
         ),
-        (
-            readers,
-            vk::AccessFlags2::SHADER_READ
-                | vk::AccessFlags2::SHADER_WRITE
-                | vk::AccessFlags2::INDIRECT_COMMAND_READ,
-        ),
+        (readers, access),
     );
 }
 
