@@ -297,13 +297,10 @@ impl CommonArgs {
         let gi = match self.gi {
             GiMode::Dense | GiMode::Svo => {
                 cones.check()?;
+                if self.gi == GiMode::Dense && self.debug_view == DebugView::OctreeNodes {
+                    bail!("--debug-view octree-nodes shows the octree: it needs --gi svo");
+                }
                 let (voxels, structure) = if self.gi == GiMode::Svo {
-                    if self.debug_view.shows_voxels() {
-                        bail!(
-                            "--debug-view {:?}: the voxel debug views need --gi dense",
-                            self.debug_view
-                        );
-                    }
                     let depth = self.octree_depth.unwrap_or(voxels.trailing_zeros());
                     check_depth(depth)?;
                     (1 << depth, VoxelStructure::Octree { capacities: None })

@@ -185,6 +185,8 @@ gpu_layout! {
         DEBUG_VOXEL_NORMAL = 4;
         /// `FrameUniforms.debug_view`: voxel radiance at mip `debug_level`.
         DEBUG_VOXEL_RADIANCE = 5;
+        /// `FrameUniforms.debug_view`: the octree's occupied nodes at depth `debug_level` below the leaves, edges drawn (`--gi svo`).
+        DEBUG_OCTREE_NODES = 6;
 
     }
 

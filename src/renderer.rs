@@ -90,17 +90,21 @@ pub enum DebugView {
     VoxelNormal,
     /// Voxel radiance at mip `--debug-level`, from the volume facing the camera ray.
     VoxelRadiance,
+    /// The octree's occupied nodes `--debug-level` levels above the leaves, each in its
+    /// own colour with its edges drawn (`--gi svo` only).
+    OctreeNodes,
 }
 
 impl DebugView {
     /// Every view, in the viewer's cycling order.
-    pub const ALL: [DebugView; 6] = [
+    pub const ALL: [DebugView; 7] = [
         DebugView::None,
         DebugView::Indirect,
         DebugView::Ao,
         DebugView::VoxelAlbedo,
         DebugView::VoxelNormal,
         DebugView::VoxelRadiance,
+        DebugView::OctreeNodes,
     ];
 
     fn code(self) -> u32 {
@@ -111,6 +115,7 @@ impl DebugView {
             DebugView::VoxelAlbedo => layout::DEBUG_VOXEL_ALBEDO,
             DebugView::VoxelNormal => layout::DEBUG_VOXEL_NORMAL,
             DebugView::VoxelRadiance => layout::DEBUG_VOXEL_RADIANCE,
+            DebugView::OctreeNodes => layout::DEBUG_OCTREE_NODES,
         }
     }
 
@@ -118,7 +123,10 @@ impl DebugView {
     pub fn shows_voxels(self) -> bool {
         matches!(
             self,
-            DebugView::VoxelAlbedo | DebugView::VoxelNormal | DebugView::VoxelRadiance
+            DebugView::VoxelAlbedo
+                | DebugView::VoxelNormal
+                | DebugView::VoxelRadiance
+                | DebugView::OctreeNodes
         )
     }
 }

@@ -62,8 +62,8 @@ fn svo_settings_are_checked() {
         (&["--gi", "svo", "--octree-depth", "5"], "between 6 and 10"),
         (&["--gi", "dense", "--octree-depth", "7"], "needs --gi svo"),
         (
-            &["--gi", "svo", "--debug-view", "voxel-albedo"],
-            "need --gi dense",
+            &["--gi", "dense", "--debug-view", "octree-nodes"],
+            "needs --gi svo",
         ),
     ];
     for (extra, expected) in cases {
@@ -75,4 +75,40 @@ fn svo_settings_are_checked() {
         assert!(err.contains(expected), "{extra:?}: {err}");
         assert!(!err.contains("panicked"), "{err}");
     }
+}
+
+/// The octree debug view draws occupied nodes: on the Cornell box at level 2 (nodes of
+/// 8^3 voxels) most of the image is covered, in more than a few colours.
+#[test]
+fn octree_node_view_draws_nodes() {
+    let dir = temp_dir("svo_nodes");
+    let out = dir.join("nodes.png");
+    render(
+        &voxcone::cli::default_scene(),
+        &[
+            "--gi",
+            "svo",
+            "--debug-view",
+            "octree-nodes",
+            "--debug-level",
+            "2",
+        ],
+        &out,
+    );
+    let (image, _) = load_rgb(&out).unwrap();
+    let pixels: Vec<[u8; 3]> = image
+        .data
+        .chunks_exact(3)
+        .map(|p| [p[0], p[1], p[2]].map(|c| (c * 255.0).round() as u8))
+        .collect();
+    let covered = pixels.iter().filter(|p| **p != [0, 0, 0]).count();
+    let colours: std::collections::HashSet<_> = pixels.iter().collect();
+    eprintln!(
+        "{} of {} pixels covered, {} colours",
+        covered,
+        pixels.len(),
+        colours.len()
+    );
+    assert!(covered > pixels.len() * 3 / 4);
+    assert!(colours.len() > 50);
 }

@@ -82,6 +82,19 @@ uint leaf_sum_base(uint entry, uint octant) {
     return SVO_SUM_WORDS * (((entry & SVO_CHILD_MASK) >> 8) + uint(before));
 }
 
+// The texel of voxel v in its leaf's attribute bricks; false where no leaf holds it.
+bool leaf_texel(uvec3 v, out ivec3 texel) {
+    uint leaf = find_node(v, svo_depth() - 1u);
+    uint brick = leaf == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[leaf];
+    texel = ivec3(0);
+    if (brick == SVO_NO_BRICK) {
+        return false;
+    }
+    uint side = counters.leaf_pool_side;
+    texel = ivec3(brick % side, (brick / side) % side, brick / (side * side)) * int(SVO_ATTRIBUTE_BRICK) + ivec3(v & 1u);
+    return true;
+}
+
 // The corner texel of brick `slot` in a pool of `side`³ bricks of `edge`³ texels.
 ivec3 brick_origin(uint slot, uint side, uint edge) {
     return ivec3(slot % side, (slot / side) % side, slot / (side * side)) * int(edge);

@@ -1,5 +1,6 @@
-//! Debug views of the voxels: albedo, normal or radiance at a chosen mip level, marched
-//! per pixel from the camera (`glsl/gi/debug/voxel_view.comp`).
+//! Debug views of the voxels: albedo, normal or radiance at a chosen mip level, or the
+//! octree's nodes at a chosen level, marched per pixel from the camera
+//! (`glsl/gi/debug/voxel_view.comp`).
 
 use std::sync::Arc;
 
@@ -14,15 +15,19 @@ pub struct VoxelViewPass {
 }
 
 impl VoxelViewPass {
-    /// `set_layouts` are those of sets 0, 1 and 2.
-    pub fn new(ctx: &Arc<Context>, set_layouts: [vk::DescriptorSetLayout; 3]) -> Result<Self> {
-        let pipeline = Pipeline::compute(
-            ctx,
-            "voxel_view",
-            crate::vk::shaders::GI_DEBUG_VOXEL_VIEW_COMP,
-            &set_layouts,
-            0,
-        )?;
+    /// `set_layouts` are those of sets 0, 1 and 2; `octree` picks the variant that looks
+    /// the voxels up in the octree (and draws its nodes).
+    pub fn new(
+        ctx: &Arc<Context>,
+        set_layouts: [vk::DescriptorSetLayout; 3],
+        octree: bool,
+    ) -> Result<Self> {
+        let spirv = if octree {
+            crate::vk::shaders::GI_DEBUG_VOXEL_VIEW_COMP_VOXELS_SVO
+        } else {
+            crate::vk::shaders::GI_DEBUG_VOXEL_VIEW_COMP
+        };
+        let pipeline = Pipeline::compute(ctx, "voxel_view", spirv, &set_layouts, 0)?;
         Ok(Self { pipeline })
     }
 

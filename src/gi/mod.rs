@@ -383,7 +383,6 @@ struct Dense {
     voxelize: voxelize::VoxelizePass,
     compact: compact::CompactPass,
     filter: filter::FilterPass,
-    voxel_view: debug::VoxelViewPass,
     /// Re-voxelize everything every frame.
     full_update: bool,
     /// The static meshes are in the voxels (or in `Volumes::static_packed`).
@@ -412,6 +411,7 @@ pub struct VoxelGi {
     /// Created with the screen targets.
     low_res: Option<LowRes>,
     cone_trace: cone_trace::ConeTracePass,
+    voxel_view: debug::VoxelViewPass,
     set: vk::DescriptorSet,
     _sets: DescriptorSets,
     uniforms: Buffer,
@@ -482,7 +482,6 @@ impl Dense {
                 layouts,
             )?,
             filter: filter::FilterPass::new(ctx, [layouts[0], layouts[1]], &volumes)?,
-            voxel_view: debug::VoxelViewPass::new(ctx, layouts)?,
             compact,
             volumes,
             full_update,
@@ -744,6 +743,7 @@ impl VoxelGi {
             indirect_scale: 1,
             low_res: None,
             cone_trace: cone_trace::ConeTracePass::new(ctx, layouts, octree)?,
+            voxel_view: debug::VoxelViewPass::new(ctx, layouts, octree)?,
             set,
             _sets: sets,
             uniforms,
@@ -936,10 +936,10 @@ impl VoxelGi {
         extent: vk::Extent2D,
         voxel_view: bool,
     ) {
-        if let (true, Voxels::Dense(dense)) = (voxel_view, &self.voxels) {
+        if voxel_view {
             timer.begin(cmd, "voxel_view");
             compute_to_compute(&self.ctx, cmd);
-            dense.voxel_view.record(cmd, frame_set, self.set, extent);
+            self.voxel_view.record(cmd, frame_set, self.set, extent);
             timer.end(cmd);
             return;
         }

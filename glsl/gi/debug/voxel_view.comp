@@ -1,8 +1,11 @@
 #version 460
+// variant: VOXELS_SVO
 // Debug views of the voxels: each pixel marches its camera ray through the grid in
 // cells of 2^debug_level voxels and shows the first cell that holds geometry: its mean
 // albedo, mean normal (xyz * 0.5 + 0.5), or radiance composited front to back from the
-// anisotropic level facing the ray (the base voxels at level 0).
+// anisotropic level facing the ray (the base voxels at level 0). With VOXELS_SVO the
+// voxels are looked up in the octree, whose nodes at that level the octree view draws,
+// each in its own colour, darker towards its edges.
 #include "gi/cones.glsl"
 
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
@@ -22,10 +25,18 @@ vec4 cell_mean(ivec3 cell, int size, bool normal) {
             for (int x = 0; x < size; x += stride) {
                 ivec3 v = cell * size + ivec3(x, y, z);
                 count += 1.0;
-                vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, v).r);
+#ifdef VOXELS_SVO
+                ivec3 texel;
+                if (!leaf_texel(uvec3(v), texel)) {
+                    continue;
+                }
+#else
+                ivec3 texel = v;
+#endif
+                vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, texel).r);
                 if (albedo.a > 0.0) {
                     occupied += 1.0;
-                    sum += normal ? unpack_rgba8(imageLoad(voxel_normal, v).r).rgb : albedo.rgb;
+                    sum += normal ? unpack_rgba8(imageLoad(voxel_normal, texel).r).rgb : albedo.rgb;
                 }
             }
         }
@@ -57,6 +68,25 @@ void main() {
     for (float t = t_in + 0.25 * cell; t < t_out && acc.a < 0.99; t += 0.25 * cell) {
         vec3 at = eye + dir * t;
         ivec3 c = clamp(ivec3(floor((at - lo) / cell)), ivec3(0), ivec3(cells - 1));
+#ifdef VOXELS_SVO
+        if (frame.debug_view == DEBUG_OCTREE_NODES) {
+            // debug_level 0 shows the leaves, 1 their parents, and so on up.
+            uint node_level = svo_depth() - 1u - min(uint(level), svo_depth() - 1u);
+            uint shift = svo_depth() - node_level;
+            uvec3 v = uvec3(clamp(ivec3(floor((at - lo) / gi.origin.w)), ivec3(0), ivec3(int(gi.resolution) - 1)));
+            uint node = find_node((v >> shift) << shift, node_level);
+            if (node != SVO_NO_NODE && node_bricks[node] != SVO_NO_BRICK) {
+                float node_size = gi.origin.w * float(1u << shift);
+                vec3 local = fract((at - lo) / node_size);
+                vec3 edge = min(local, 1.0 - local);
+                int near_edges = int(edge.x < 0.06) + int(edge.y < 0.06) + int(edge.z < 0.06);
+                uint h = node * 2654435761u;
+                vec3 colour = 0.35 + 0.65 * vec3(h & 0xffu, (h >> 8) & 0xffu, (h >> 16) & 0xffu) / 255.0;
+                acc = vec4(near_edges >= 2 ? colour * 0.15 : colour, 1.0);
+            }
+            continue;
+        }
+#endif
         if (frame.debug_view == DEBUG_VOXEL_RADIANCE) {
             // The cell's centre, so that the view shows the cells unfiltered.
             vec3 uvw = (vec3(c) + 0.5) * cell / grid_size;

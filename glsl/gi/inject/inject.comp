@@ -22,12 +22,8 @@ layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform writeonly i
 // Whether voxel v of the grid holds a surface.
 bool voxel_occupied(ivec3 v) {
 #ifdef VOXELS_SVO
-    uint leaf = find_node(uvec3(v), svo_depth() - 1u);
-    if (leaf == SVO_NO_NODE || node_bricks[leaf] == SVO_NO_BRICK) {
-        return false;
-    }
-    ivec3 texel = brick_origin(node_bricks[leaf], counters.leaf_pool_side, SVO_ATTRIBUTE_BRICK) + (v & 1);
-    return (imageLoad(voxel_albedo, texel).r >> 24) != 0u;
+    ivec3 texel;
+    return leaf_texel(uvec3(v), texel) && (imageLoad(voxel_albedo, texel).r >> 24) != 0u;
 #else
     return (imageLoad(voxel_albedo, v).r >> 24) != 0u;
 #endif
