@@ -350,6 +350,14 @@ gpu_layout! {
         uint leaf_voxels,
         /// Leaf voxels the sums buffer holds.
         uint leaf_voxel_capacity,
+        /// Fragments of the static meshes, listed first (the moving meshes' follow).
+        uint static_fragment_count,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+        /// Unused.
+        uint pad2,
     }
 
     /// One level of the octree: its nodes are contiguous in the node pool.

@@ -278,7 +278,7 @@ impl Renderer {
         let composite = CompositePass::new(ctx, set_layouts, output_format)?;
         let gi = settings
             .gi
-            .map(|g| VoxelGi::new(ctx, &scene, &g, set_layouts))
+            .map(|g| VoxelGi::new(ctx, &scene, &g, set_layouts, FRAMES_IN_FLIGHT))
             .transpose()?;
         let nearest_sampler = Sampler::new(
             ctx,
@@ -635,7 +635,7 @@ impl Renderer {
 
         let gi = self.gi.as_mut().filter(|_| self.indirect);
         if let Some(gi) = gi {
-            gi.record_update(cmd, timer, &draw);
+            gi.record_update(cmd, timer, &draw, frame.slot)?;
         }
 
         // With soft-shadow cones the GI's upsample pass shades every pixel.

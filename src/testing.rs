@@ -66,3 +66,27 @@ pub fn render_frames(
     renderer.finish().unwrap();
     (ctx, renderer)
 }
+
+/// The Cornell box at `cornell` with a cube flying across it (x oscillating by 0.6 over 4
+/// seconds), written into `dir`.
+pub fn moving_cube_scene(cornell: &std::path::Path, dir: &std::path::Path) -> Scene {
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(
+        dir.join("cube.obj"),
+        "v -0.15 0.3 -0.15\nv 0.15 0.3 -0.15\nv 0.15 0.6 -0.15\nv -0.15 0.6 -0.15\n\
+        v -0.15 0.3 0.15\nv 0.15 0.3 0.15\nv 0.15 0.6 0.15\nv -0.15 0.6 0.15\n\
+        f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n",
+    )
+    .unwrap();
+    let scene_file = dir.join("moving.toml");
+    std::fs::write(
+        &scene_file,
+        format!(
+            "[[mesh]]\npath = {:?}\n[[mesh]]\npath = \"cube.obj\"\n\
+             animate = {{ kind = \"oscillate\", axis = [1, 0, 0], amplitude = 0.6, period_s = 4 }}\n",
+            cornell.to_string_lossy()
+        ),
+    )
+    .unwrap();
+    Scene::load(&scene_file, &crate::scene::LoadOptions::default()).unwrap()
+}

@@ -647,12 +647,14 @@ impl Dense {
 }
 
 impl VoxelGi {
-    /// `set_layouts` are those of sets 0 and 1.
+    /// `set_layouts` are those of sets 0 and 1; `frames_in_flight` frames may be recorded
+    /// before the first is done.
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
         settings: &GiSettings,
         set_layouts: [vk::DescriptorSetLayout; 2],
+        frames_in_flight: usize,
     ) -> Result<Self> {
         let resolution = settings.voxels;
         let cones = settings.cones;
@@ -715,10 +717,10 @@ impl VoxelGi {
                 linear.raw,
             )?)),
             VoxelStructure::Octree { capacities } => {
-                if scene.is_animated() || settings.full_update {
+                if settings.full_update {
                     bail!(
-                        "--gi svo builds the octree once: moving meshes and --full-update \
-                         need --gi dense for now"
+                        "--gi svo voxelizes the static meshes once: --full-update needs \
+                         --gi dense"
                     );
                 }
                 Voxels::Octree(Box::new(SvoGi::new(
@@ -729,6 +731,7 @@ impl VoxelGi {
                     layouts,
                     set,
                     linear.raw,
+                    frames_in_flight,
                 )?))
             }
         };
@@ -868,12 +871,16 @@ impl VoxelGi {
     /// The first frame computes all bounces. Later frames compute one, gathering from the
     /// previous frame's filtered radiance, so bounces accumulate over frames at the cost
     /// of one (moving light takes a few frames to settle in the indirect light).
+    ///
+    /// With moving meshes the octree is rebuilt every frame, its bricks are assigned
+    /// anew, and every frame computes all bounces. `slot` is the frame's slot in flight.
     pub fn record_update(
         &mut self,
         cmd: vk::CommandBuffer,
         timer: &mut GpuTimer,
         draw: &SceneDraw,
-    ) {
+        slot: usize,
+    ) -> Result<()> {
         let ctx = &self.ctx;
         let n = self.grid.resolution;
         let set = self.set;
@@ -882,8 +889,14 @@ impl VoxelGi {
                 dense.record_voxelize(ctx, cmd, timer, draw, set, n);
                 dense.compact.list.raw
             }
-            // Built before the first frame.
-            Voxels::Octree(svo) => svo.voxel_list(),
+            // Built before the first frame; rebuilt every frame around moving meshes.
+            Voxels::Octree(svo) => {
+                if svo.moving() {
+                    svo.record_moving(cmd, timer, draw, set, slot)?;
+                    self.history = false;
+                }
+                svo.voxel_list()
+            }
         };
 
         timer.begin(cmd, "inject");
@@ -924,6 +937,7 @@ impl VoxelGi {
             filter(&self.voxels);
             timer.end(cmd);
         }
+        Ok(())
     }
 
     /// Adds the cone-traced light to `radiance` (written by the lighting pass), or with

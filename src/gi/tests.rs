@@ -10,7 +10,7 @@ use super::{Grid, Volume};
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
-use crate::testing::{gi_settings, render_frames};
+use crate::testing::{gi_settings, moving_cube_scene, render_frames};
 use crate::vk::Context;
 
 /// Renders 64x64 frames of `scene` with `--gi dense --voxels n`, one at each time,
@@ -155,25 +155,7 @@ fn moving_mesh_leaves_no_voxels_behind() {
         return;
     };
     let dir = std::env::temp_dir().join(format!("voxcone-moving-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("cube.obj"),
-        "v -0.15 0.3 -0.15\nv 0.15 0.3 -0.15\nv 0.15 0.6 -0.15\nv -0.15 0.6 -0.15\n\
-        v -0.15 0.3 0.15\nv 0.15 0.3 0.15\nv 0.15 0.6 0.15\nv -0.15 0.6 0.15\n\
-        f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n",
-    )
-    .unwrap();
-    let scene_file = dir.join("moving.toml");
-    std::fs::write(
-        &scene_file,
-        format!(
-            "[[mesh]]\npath = {:?}\n[[mesh]]\npath = \"cube.obj\"\n\
-             animate = {{ kind = \"oscillate\", axis = [1, 0, 0], amplitude = 0.6, period_s = 4 }}\n",
-            cornell.to_string_lossy()
-        ),
-    )
-    .unwrap();
-    let scene = Scene::load(&scene_file, &LoadOptions::default()).unwrap();
+    let scene = moving_cube_scene(&cornell, &dir);
     let times = [0.0, 0.5, 1.0];
     let (ctx, moved) = render_at(scene.clone(), 32, &times, false);
     let moved_voxels = occupancy(&moved);

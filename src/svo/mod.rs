@@ -24,7 +24,7 @@ use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel, VoxelListHeader};
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
-    clear_to_zero, copies_to_host_barrier, memory_barrier, update_buffer, Binding, Buffer, Context,
+    clear_to_zero, copies_to_host_barrier, stage_barrier, update_buffer, Binding, Buffer, Context,
     GpuTimer, Image, ImageDesc, ImageUse, OneShot, SetWriter,
 };
 
@@ -216,6 +216,9 @@ struct Pools {
     voxel_list: Buffer,
     /// Per leaf voxel, its fragments' attribute sums and count (`SVO_SUM_WORDS` words).
     sums: Buffer,
+    /// The images have been cleared once (they are in GENERAL layout since, read and
+    /// written by any pass of earlier frames).
+    cleared: std::cell::Cell<bool>,
 }
 
 const COUNTERS_BYTES: usize = std::mem::size_of::<SvoCounters>()
@@ -312,6 +315,7 @@ impl Pools {
                 4 * u64::from(layout::SVO_SUM_WORDS) * u64::from(capacities.leaf_voxels),
                 vk::BufferUsageFlags::empty(),
             )?,
+            cleared: std::cell::Cell::new(false),
         })
     }
 
@@ -349,6 +353,20 @@ impl Pools {
                 vk::ImageLayout::GENERAL,
             )
             .apply();
+    }
+
+    /// The state of the images before a build clears them: new (the first time), or
+    /// whatever any shader of an earlier frame did with them.
+    fn last_use(&self) -> ImageUse {
+        if self.cleared.get() {
+            ImageUse {
+                layout: vk::ImageLayout::GENERAL,
+                stage: vk::PipelineStageFlags2::ALL_COMMANDS,
+                access: vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE,
+            }
+        } else {
+            ImageUse::UNDEFINED
+        }
     }
 
     fn bytes(&self) -> Vec<(&'static str, u64)> {
@@ -505,6 +523,11 @@ pub struct SvoGi {
     octree: octree::OctreePasses,
     bricks: bricks::BrickPasses,
     report: Option<BuildReport>,
+    /// The scene has moving meshes: their fragments are listed after the static ones
+    /// every frame, and the octree is rebuilt from all of them.
+    moving: bool,
+    /// Per frame in flight: its counters, read when the slot comes round again.
+    frame_counters: Vec<Buffer>,
     /// The radiance pools' sampler (the GI set refers to it).
     linear: vk::Sampler,
     ctx: Arc<Context>,
@@ -514,6 +537,8 @@ impl SvoGi {
     /// `layouts` are those of sets 0, 1 and 2 (the GI set, into which the pools are
     /// written, with `linear` as the radiance pools' sampler). `capacities` overrides the
     /// first guess of the pool sizes (the overflow test starts from tiny pools).
+    /// `frames_in_flight` frames may be recorded before the first is done.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
@@ -522,6 +547,7 @@ impl SvoGi {
         layouts: [vk::DescriptorSetLayout; 3],
         set: vk::DescriptorSet,
         linear: vk::Sampler,
+        frames_in_flight: usize,
     ) -> Result<Self> {
         check_depth(depth)?;
         let grid = Grid::around(scene, 1 << depth);
@@ -562,9 +588,28 @@ impl SvoGi {
             octree: octree::OctreePasses::new(ctx, layouts)?,
             bricks: bricks::BrickPasses::new(ctx, layouts)?,
             report: None,
+            moving: scene.is_animated(),
+            frame_counters: (0..frames_in_flight)
+                .map(|i| {
+                    let mut buffer = Buffer::new(
+                        ctx,
+                        &format!("svo frame counters {i}"),
+                        COUNTERS_BYTES as u64,
+                        vk::BufferUsageFlags::TRANSFER_DST,
+                        MemoryLocation::GpuToCpu,
+                    )?;
+                    buffer.write(0, &[0; COUNTERS_BYTES]);
+                    Ok(buffer)
+                })
+                .collect::<Result<_>>()?,
             linear,
             ctx: ctx.clone(),
         })
+    }
+
+    /// Whether the scene has moving meshes (the octree is rebuilt every frame).
+    pub fn moving(&self) -> bool {
+        self.moving
     }
 
     /// The occupied leaf voxels: the indirect dispatch of voxel shading and bounces.
@@ -679,7 +724,7 @@ impl SvoGi {
             timer.reset(cmd);
             match phase {
                 Phase::Fragments => self.record_fragments(cmd, &mut timer, draw, set),
-                Phase::Octree => self.record_octree(cmd, &mut timer, draw.frame_set, set),
+                Phase::Octree => self.record_octree(cmd, &mut timer, draw.frame_set, set, true),
             }
             self.copy_counters(cmd, readback.raw);
             Ok(())
@@ -710,6 +755,7 @@ impl SvoGi {
             fragment_capacity: self.fragments.capacity,
             ..Default::default()
         };
+        // The whole head (the octree phase resets its part but for the overflow bits).
         update_buffer(
             ctx,
             cmd,
@@ -719,31 +765,127 @@ impl SvoGi {
             vk::PipelineStageFlags2::FRAGMENT_SHADER,
         );
         timer.begin(cmd, "fragments");
-        self.voxelize
-            .record(ctx, cmd, draw, set, self.grid.resolution, Meshes::All);
-        memory_barrier(
+        let n = self.grid.resolution;
+        if self.moving {
+            self.voxelize.record(ctx, cmd, draw, set, n, Meshes::Static);
+            self.copy_static_count(cmd);
+            self.voxelize.record(ctx, cmd, draw, set, n, Meshes::Moving);
+        } else {
+            self.voxelize.record(ctx, cmd, draw, set, n, Meshes::All);
+            self.copy_static_count(cmd);
+        }
+        stage_barrier(
             ctx,
             cmd,
-            (
-                vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                vk::AccessFlags2::SHADER_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::TRANSFER_READ,
-            ),
+            vk::PipelineStageFlags2::FRAGMENT_SHADER,
+            vk::PipelineStageFlags2::COPY,
         );
         timer.end(cmd);
     }
 
+    /// Copies the fragments listed so far into `static_fragment_count` (after the static
+    /// meshes' draws).
+    fn copy_static_count(&self, cmd: vk::CommandBuffer) {
+        let ctx = &self.ctx;
+        stage_barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags2::FRAGMENT_SHADER,
+            vk::PipelineStageFlags2::COPY,
+        );
+        let region = vk::BufferCopy {
+            src_offset: std::mem::offset_of!(SvoCounters, fragment_count) as u64,
+            dst_offset: std::mem::offset_of!(SvoCounters, static_fragment_count) as u64,
+            size: 4,
+        };
+        let raw = self.counters.raw;
+        unsafe { ctx.device.cmd_copy_buffer(cmd, raw, raw, &[region]) };
+        stage_barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags2::COPY,
+            vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        );
+    }
+
+    /// With moving meshes, every frame: their fragments listed anew after the static
+    /// ones (kept from the build), and the octree rebuilt from all of them. A pool that
+    /// overflowed in an earlier frame (its counters are read back when its slot comes
+    /// round) is grown first, with the GPU idle, by a full build.
+    pub fn record_moving(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
+        draw: &SceneDraw,
+        set: vk::DescriptorSet,
+        slot: usize,
+    ) -> Result<()> {
+        let seen: SvoCounters = bytemuck::pod_read_unaligned(
+            &self.frame_counters[slot].mapped()[..std::mem::size_of::<SvoCounters>()],
+        );
+        if seen.overflow != 0 {
+            log::warn!(
+                "SVO pools overflowed while meshes moved ({}); rebuilding",
+                overflowed(&seen, &self.pools.capacities).join("; ")
+            );
+            self.ctx.wait_idle()?;
+            self.frame_counters[slot].write(0, &[0; COUNTERS_BYTES]);
+            self.build(draw, set)?;
+        }
+        let ctx = &self.ctx;
+        let report = self.report.as_ref().context("the octree was not built")?;
+        let statics = report.counters.static_fragment_count;
+        // The fragment fields, the node counts and the overflow bits.
+        let head = [
+            statics.div_ceil(layout::SVO_GROUP_SIZE),
+            1,
+            1,
+            statics,
+            self.fragments.capacity,
+            0,
+            0,
+            0,
+        ];
+        stage_barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::PipelineStageFlags2::ALL_TRANSFER,
+        );
+        update_buffer(
+            ctx,
+            cmd,
+            self.counters.raw,
+            0,
+            bytemuck::cast_slice(&head),
+            vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        );
+        timer.begin(cmd, "fragments");
+        self.voxelize
+            .record(ctx, cmd, draw, set, self.grid.resolution, Meshes::Moving);
+        stage_barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+        );
+        timer.end(cmd);
+        self.record_octree(cmd, timer, draw.frame_set, set, false);
+        self.copy_counters(cmd, self.frame_counters[slot].raw);
+        Ok(())
+    }
+
     /// Records the second phase, from the fragments: the octree's counters reset, the
     /// octree, leaf bricks, the list of occupied leaf voxels, and cleared radiance pools.
+    /// `reset_overflow` clears the overflow bits too (a frame keeps those its moving
+    /// meshes' fragments set).
     fn record_octree(
         &self,
         cmd: vk::CommandBuffer,
         timer: &mut GpuTimer,
         frame_set: vk::DescriptorSet,
         set: vk::DescriptorSet,
+        reset_overflow: bool,
     ) {
         let ctx = &self.ctx;
         let p = &self.pools;
@@ -768,43 +910,45 @@ impl SvoGi {
             count: 1,
             ..Default::default()
         };
+        // From `node_count` on, but the overflow bits (the fragments' may be set) and the
+        // static fragments' count.
+        let bytes = bytemuck::bytes_of(&counters);
         let from = std::mem::offset_of!(SvoCounters, node_count);
-        let mut head = bytemuck::bytes_of(&counters)[from..].to_vec();
-        head.extend_from_slice(bytemuck::bytes_of(&root));
-        memory_barrier(
+        let overflow = std::mem::offset_of!(SvoCounters, overflow);
+        let after = if reset_overflow {
+            overflow
+        } else {
+            overflow + 4
+        };
+        let statics = std::mem::offset_of!(SvoCounters, static_fragment_count);
+        let mut tail = bytes[statics + 4..].to_vec();
+        tail.extend_from_slice(bytemuck::bytes_of(&root));
+        stage_barrier(
             ctx,
             cmd,
-            (
-                vk::PipelineStageFlags2::ALL_COMMANDS,
-                vk::AccessFlags2::MEMORY_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-                vk::AccessFlags2::TRANSFER_WRITE,
-            ),
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::PipelineStageFlags2::ALL_TRANSFER,
         );
         unsafe {
+            let raw = self.counters.raw;
             ctx.device
-                .cmd_update_buffer(cmd, self.counters.raw, from as u64, &head);
+                .cmd_update_buffer(cmd, raw, from as u64, &bytes[from..overflow]);
+            // `after` is `overflow` when the bits are reset with what follows.
+            ctx.device
+                .cmd_update_buffer(cmd, raw, after as u64, &bytes[after..statics]);
+            ctx.device
+                .cmd_update_buffer(cmd, raw, statics as u64 + 4, &tail);
             // The root: no children yet, at (0, 0, 0).
             ctx.device.cmd_fill_buffer(cmd, p.nodes.raw, 0, 4, 0);
             ctx.device.cmd_fill_buffer(cmd, p.coords.raw, 0, 4, 0);
             ctx.device
                 .cmd_fill_buffer(cmd, p.sums.raw, 0, vk::WHOLE_SIZE, 0);
         }
-        memory_barrier(
+        stage_barrier(
             ctx,
             cmd,
-            (
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-                vk::AccessFlags2::TRANSFER_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
-                vk::AccessFlags2::SHADER_READ
-                    | vk::AccessFlags2::SHADER_WRITE
-                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
-            ),
+            vk::PipelineStageFlags2::ALL_TRANSFER,
+            vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
         );
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, set)];
         let counters = self.counters.raw;
@@ -813,7 +957,7 @@ impl SvoGi {
 
         timer.begin(cmd, "brick fill");
         for image in &p.leaf_attributes {
-            clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, BRICK_USE);
+            clear_to_zero(ctx, cmd, image, p.last_use(), BRICK_USE);
         }
         self.bricks.record_fill(cmd, &sets, counters);
         compute_to_compute(ctx, cmd);
@@ -838,19 +982,14 @@ impl SvoGi {
             .record_list(cmd, &sets, counters, self.depth - 1);
         // Voxel shading writes only the listed voxels: the others must read zero.
         for image in [&p.leaf_direct, &p.leaf_radiance, &p.directional] {
-            clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, RADIANCE_USE);
+            clear_to_zero(ctx, cmd, image, p.last_use(), RADIANCE_USE);
         }
-        memory_barrier(
+        p.cleared.set(true);
+        stage_barrier(
             ctx,
             cmd,
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
-                vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::INDIRECT_COMMAND_READ,
-            ),
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
         );
         timer.end(cmd);
     }
@@ -859,17 +998,11 @@ impl SvoGi {
     /// command buffer.
     fn copy_counters(&self, cmd: vk::CommandBuffer, to: vk::Buffer) {
         let ctx = &self.ctx;
-        memory_barrier(
+        stage_barrier(
             ctx,
             cmd,
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::TRANSFER_READ,
-            ),
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::PipelineStageFlags2::COPY,
         );
         let region = vk::BufferCopy::default().size(COUNTERS_BYTES as u64);
         unsafe {

@@ -6,11 +6,11 @@ use std::sync::Arc;
 use super::{Capacities, SvoGi};
 use crate::gi::reference;
 use crate::gi::VoxelStructure;
-use crate::gpu_layout as layout;
+use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel};
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
-use crate::testing::{gi_settings, render_frames};
+use crate::testing::{gi_settings, moving_cube_scene, render_frames};
 use crate::vk::Context;
 
 /// A renderer whose octree of `scene` is built at `depth`, after `frames` frames.
@@ -51,10 +51,23 @@ fn unpack(p: u32) -> [u32; 3] {
     [p & 0x3ff, (p >> 10) & 0x3ff, p >> 20]
 }
 
+/// The counters and level table as they are now (after the last frame's rebuild).
+fn live_counters(svo: &SvoGi) -> (SvoCounters, Vec<SvoLevel>) {
+    let words = svo.download_words(&svo.counters).unwrap();
+    let bytes: &[u8] = bytemuck::cast_slice(&words);
+    let head = std::mem::size_of::<SvoCounters>();
+    let levels = bytes[head..]
+        .chunks_exact(std::mem::size_of::<SvoLevel>())
+        .take(svo.depth as usize)
+        .map(bytemuck::pod_read_unaligned)
+        .collect();
+    (bytemuck::pod_read_unaligned(&bytes[..head]), levels)
+}
+
 fn download(svo: &SvoGi) -> Downloaded {
-    let report = svo.report().unwrap();
+    let (counters, levels) = live_counters(svo);
     let p = &svo.pools;
-    let stored = report.counters.fragment_count as usize;
+    let stored = counters.fragment_count as usize;
     let voxels = svo.download_words(&svo.fragments.voxels).unwrap();
     let shading = svo.download_words(&svo.fragments.shading).unwrap();
     Downloaded {
@@ -66,7 +79,7 @@ fn download(svo: &SvoGi) -> Downloaded {
                 emission: shading[2 * i + 1],
             })
             .collect(),
-        levels: report.levels.iter().map(|l| (l.first, l.count)).collect(),
+        levels: levels.iter().map(|l| (l.first, l.count)).collect(),
         children: svo.download_words(&p.nodes).unwrap(),
         coords: svo
             .download_words(&p.coords)
@@ -110,7 +123,8 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
         );
     }
     let total: u32 = d.levels.iter().map(|l| l.1).sum();
-    assert_eq!(total, svo.report().unwrap().counters.node_count);
+    let counters = live_counters(svo).0;
+    assert_eq!(total, counters.node_count);
 
     let mut by_coords: Vec<HashMap<[u32; 3], u32>> = Vec::new();
     let mut leaf_bricks = HashSet::new();
@@ -175,7 +189,6 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
         }
         by_coords.push(map);
     }
-    let counters = svo.report().unwrap().counters;
     assert_eq!(leaf_bricks.len() as u32, counters.leaf_bricks);
     // The leaves' sums tile the sums buffer without gaps or overlaps.
     leaf_sums.sort_unstable();
@@ -610,4 +623,61 @@ fn bricks_filter_and_borders_match_cpu() {
     eprintln!("{borders} border texels hold their neighbours' voxels");
     assert!(checked > 0 && borders > 0);
     assert_eq!(ctx.validation_messages(), 0);
+}
+
+/// A mesh moving across the box leaves no nodes or voxels behind: after frames at three
+/// times, the octree (nodes per level, leaf voxels and their albedo) equals a fresh build
+/// at the last time, and differs from the first time's.
+#[test]
+fn moving_mesh_leaves_no_nodes_behind() {
+    let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("voxcone-svo-moving-{}", std::process::id()));
+    let scene = moving_cube_scene(&cornell, &dir);
+    let settings = gi_settings(64, VoxelStructure::Octree { capacities: None }, false);
+    let (ctx, moved) = render_frames(scene.clone(), settings.clone(), &[0.0, 0.5, 1.0]);
+    let (_, fresh) = render_frames(scene.clone(), settings.clone(), &[1.0]);
+    let (_, start) = render_frames(scene, settings, &[0.0]);
+    // Leaf voxels with their albedo, and nodes per level.
+    let snapshot = |r: &Renderer| {
+        let svo = r.gi().unwrap().octree().unwrap();
+        let d = download(svo);
+        let albedo = svo.download_leaf_attribute(0).unwrap();
+        let side = svo.pools.leaf_side;
+        let edge = side * layout::SVO_ATTRIBUTE_BRICK;
+        let mut voxels = Vec::new();
+        for (_, brick, c, k) in brick_voxels(&d, svo.depth as usize - 1) {
+            let o = [brick % side, (brick / side) % side, brick / (side * side)];
+            let t: [u32; 3] = std::array::from_fn(|a| o[a] * layout::SVO_ATTRIBUTE_BRICK + k[a]);
+            let word = albedo[(t[0] + edge * (t[1] + edge * t[2])) as usize];
+            if word != 0 {
+                voxels.push((std::array::from_fn::<u32, 3, _>(|a| 2 * c[a] + k[a]), word));
+            }
+        }
+        voxels.sort_unstable();
+        let nodes: Vec<u32> = d.levels.iter().map(|l| l.1).collect();
+        (nodes, voxels)
+    };
+    let (moved, fresh, start) = (snapshot(&moved), snapshot(&fresh), snapshot(&start));
+    eprintln!(
+        "nodes per level: moved {:?}, fresh {:?}, start {:?}; leaf voxels {} / {} / {}",
+        moved.0,
+        fresh.0,
+        start.0,
+        moved.1.len(),
+        fresh.1.len(),
+        start.1.len()
+    );
+    assert_ne!(start.1, fresh.1, "the cube did not move");
+    assert_eq!(
+        moved.0, fresh.0,
+        "nodes per level differ from a fresh build"
+    );
+    assert!(
+        moved.1 == fresh.1,
+        "leaf voxels or albedo differ from a fresh build"
+    );
+    assert_eq!(ctx.validation_messages(), 0);
+    std::fs::remove_dir_all(&dir).ok();
 }

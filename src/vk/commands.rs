@@ -134,6 +134,25 @@ pub fn memory_barrier(
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
 }
 
+/// Every memory write by the stages `from` before it is visible to every read and write by
+/// the stages `to` after it.
+pub fn stage_barrier(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    from: vk::PipelineStageFlags2,
+    to: vk::PipelineStageFlags2,
+) {
+    memory_barrier(
+        ctx,
+        cmd,
+        (from, vk::AccessFlags2::MEMORY_WRITE),
+        (
+            to,
+            vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
+        ),
+    );
+}
+
 /// Clears every level and layer of a colour image to zero (all bits: any format), which
 /// was in state `before` and is left in state `after`; its contents are discarded.
 pub fn clear_to_zero(

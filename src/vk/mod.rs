@@ -12,7 +12,7 @@ mod timestamps;
 
 pub use commands::{
     clear_to_zero, copies_to_host_barrier, image_barrier, memory_barrier, read_back_buffer,
-    read_back_image, update_buffer, ImageUse, OneShot,
+    read_back_image, stage_barrier, update_buffer, ImageUse, OneShot,
 };
 pub use context::{Context, ContextOptions, Features};
 pub use descriptors::{Binding, DescriptorSets, SetWriter};
