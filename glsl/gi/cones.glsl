@@ -51,9 +51,11 @@ vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lo
     vec3 x = origin + dir * dist;
     float height = dot(x - surface, n);
     diameter = max(voxel, 2.0 * tan_half * dist);
-    footprint = min(diameter, max(height, voxel));
-    lod = max(log2(footprint / voxel), min_lod);
-    x += n * max(voxel * exp2(lod) - height, 0.0);
+    lod = max(log2(min(diameter, max(height, voxel)) / voxel), min_lod);
+    // The cell size at that mip, also where min_lod holds the mip above what the cone
+    // asks for (its opacity was filtered over that path).
+    footprint = voxel * exp2(lod);
+    x += n * max(footprint - height, 0.0);
     return (x - gi.origin.xyz) / (voxel * float(gi.resolution));
 }
 
