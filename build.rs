@@ -1,4 +1,5 @@
-//! Compiles every shader under `glsl/` to SPIR-V and embeds it in the binary.
+//! Compiles every shader under `glsl/` to SPIR-V and embeds it in the binary; a shader
+//! with `// variant: MACRO` lines is compiled once more per line with MACRO defined.
 //!
 //! Shaders `#include` headers relative to themselves or to `glsl/`, plus the generated
 //! `gpu_layout.glsl` (from `src/gpu_layout_defs.rs`, the one definition of bindings and

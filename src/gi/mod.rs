@@ -1,8 +1,11 @@
-//! Global illumination on a dense voxel grid held in 3D textures (`--gi dense`), as in
-//! Präntare (2016) and Villegas (2018), traced with cones as in Crassin et al. (2011).
+//! Global illumination by voxel cone tracing (Crassin et al. 2011): on a dense voxel grid
+//! held in 3D textures (`--gi dense`, as in Präntare 2016 and Villegas 2018), or on the
+//! sparse voxel octree of `crate::svo` (`--gi svo`), which feeds the same passes.
 //!
-//! Per frame: voxelize (clear + rasterize into packed RGBA8 averages) -> inject (voxel
-//! shading) -> filter (anisotropic mips) -> cone trace (after the direct lighting).
+//! Per frame: voxelize (clear + rasterize into packed RGBA8 averages; the octree: built
+//! once, or rebuilt around moving meshes) -> inject (voxel shading) -> filter
+//! (anisotropic mips; the octree: its bricks bottom-up) -> bounces -> cone trace (after
+//! the direct lighting).
 
 mod compact;
 mod cone_trace;
