@@ -25,6 +25,7 @@ use winit::window::{Window, WindowId};
 
 use super::{check_validation, create_context, load_scene};
 use crate::cli::ViewArgs;
+use crate::gi::VoxelStructure;
 use crate::renderer::{copy_image_to_buffer, DebugView, OutputTarget, Renderer};
 use crate::vk::{Acquired, Buffer, Context, ImageUse, Swapchain};
 
@@ -315,7 +316,12 @@ impl Viewer {
             KeyCode::Digit6 => ("emission", &mut terms.emission),
             KeyCode::KeyC => ("soft-shadow cones", &mut gi.shadow_cones),
             KeyCode::KeyV => {
-                let views = DebugView::ALL;
+                // The octree view only where there is an octree.
+                let octree = matches!(gi.structure, VoxelStructure::Octree { .. });
+                let views: Vec<DebugView> = DebugView::ALL
+                    .into_iter()
+                    .filter(|v| octree || *v != DebugView::OctreeNodes)
+                    .collect();
                 let next = views
                     .iter()
                     .position(|v| *v == settings.debug_view)

@@ -654,7 +654,7 @@ impl SvoGi {
 
     /// Builds the octree of the meshes at `draw.time_s` and waits for it: the voxel
     /// fragments, then the octree and its bricks from them. A pool that overflows is
-    /// reported (a warning, and in the report), grown, and its phase runs again.
+    /// reported (in the log, and in the report), grown, and its phase runs again.
     pub fn build(&mut self, draw: &SceneDraw, set: vk::DescriptorSet) -> Result<&BuildReport> {
         let start = Instant::now();
         let mut regrowths = Vec::new();
@@ -682,7 +682,8 @@ impl SvoGi {
                     "SVO pools too small ({}); growing them and building again",
                     overflowed(&counters, &capacities).join("; ")
                 );
-                log::warn!("{message}");
+                // The first guess is small on purpose: growing is routine.
+                log::info!("{message}");
                 regrowths.push(message);
                 ensure!(
                     regrowths.len() < 8,
