@@ -745,6 +745,16 @@ impl Renderer {
     }
 }
 
+impl Drop for Renderer {
+    /// The GPU may still be using every resource (an error can end a frame's wait
+    /// early): nothing is destroyed before it is idle.
+    fn drop(&mut self) {
+        if let Err(e) = self.ctx.wait_idle() {
+            log::error!("waiting for the GPU before freeing the renderer: {e:#}");
+        }
+    }
+}
+
 /// Records a copy of mip 0, layer 0 of a colour image in TRANSFER_SRC layout to `buffer`.
 pub fn copy_image_to_buffer(
     ctx: &Context,

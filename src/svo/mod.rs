@@ -90,6 +90,27 @@ impl Capacities {
         }
     }
 
+    /// The octree's pools fitted to what a build without overflow used, with an eighth
+    /// more (moving meshes change the counts from frame to frame); unchanged where the
+    /// capacity is already within a quarter of that.
+    fn fitted(&self, counters: &SvoCounters) -> Self {
+        let fit = |capacity: u32, used: u32| {
+            let want = used.saturating_add(used / 8).saturating_add(16);
+            if capacity > want.saturating_add(want / 4) {
+                want
+            } else {
+                capacity
+            }
+        };
+        Self {
+            fragments: self.fragments,
+            nodes: fit(self.nodes, counters.node_count),
+            leaf_bricks: fit(self.leaf_bricks, counters.leaf_bricks),
+            interior_bricks: fit(self.interior_bricks, counters.interior_bricks),
+            leaf_voxels: fit(self.leaf_voxels, counters.leaf_voxels),
+        }
+    }
+
     /// Capacities for another build after `counters` reported an overflow. The counters
     /// count past a full pool, so what a pool needed is exact when the pools it depends
     /// on did not overflow too (the fragments depend on nothing; the bricks on the node
@@ -659,10 +680,22 @@ impl SvoGi {
         let start = Instant::now();
         let mut regrowths = Vec::new();
         let mut passes = Vec::new();
+        let mut fitted = false;
         for phase in [Phase::Fragments, Phase::Octree] {
             loop {
                 let (counters, levels, timings) = self.run(phase, draw, set)?;
                 if counters.overflow == 0 {
+                    let capacities = self.pools.capacities;
+                    let fit = capacities.fitted(&counters);
+                    if phase == Phase::Octree && !fitted && fit != capacities {
+                        // Growth overshoots: size the pools to what they hold (with the
+                        // margin moving meshes need) and build the octree once more.
+                        log::info!("SVO pools fitted to what they hold: {fit:?}");
+                        fitted = true;
+                        self.pools = Pools::new(&self.ctx, fit).context("fitting the SVO pools")?;
+                        self.pools.write_set(&self.ctx, set, self.linear);
+                        continue;
+                    }
                     passes.extend(timings);
                     if phase == Phase::Octree {
                         self.report = Some(BuildReport {
