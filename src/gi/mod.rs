@@ -719,24 +719,17 @@ impl VoxelGi {
                 layouts,
                 linear.raw,
             )?)),
-            VoxelStructure::Octree { capacities } => {
-                if settings.full_update {
-                    bail!(
-                        "--gi svo voxelizes the static meshes once: --full-update needs \
-                         --gi dense"
-                    );
-                }
-                Voxels::Octree(Box::new(SvoGi::new(
-                    ctx,
-                    scene,
-                    resolution.trailing_zeros(),
-                    capacities,
-                    layouts,
-                    set,
-                    linear.raw,
-                    frames_in_flight,
-                )?))
-            }
+            VoxelStructure::Octree { capacities } => Voxels::Octree(Box::new(SvoGi::new(
+                ctx,
+                scene,
+                resolution.trailing_zeros(),
+                capacities,
+                layouts,
+                set,
+                linear.raw,
+                frames_in_flight,
+                settings.full_update,
+            )?)),
         };
         Ok(Self {
             grid,

@@ -547,6 +547,8 @@ pub struct SvoGi {
     /// The scene has moving meshes: their fragments are listed after the static ones
     /// every frame, and the octree is rebuilt from all of them.
     moving: bool,
+    /// `--full-update`: every mesh is voxelized again every frame too.
+    full_update: bool,
     /// Per frame in flight: its counters, read when the slot comes round again.
     frame_counters: Vec<Buffer>,
     /// The radiance pools' sampler (the GI set refers to it).
@@ -558,7 +560,8 @@ impl SvoGi {
     /// `layouts` are those of sets 0, 1 and 2 (the GI set, into which the pools are
     /// written, with `linear` as the radiance pools' sampler). `capacities` overrides the
     /// first guess of the pool sizes (the overflow test starts from tiny pools).
-    /// `frames_in_flight` frames may be recorded before the first is done.
+    /// `frames_in_flight` frames may be recorded before the first is done. With
+    /// `full_update` every frame voxelizes every mesh and rebuilds the octree.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Arc<Context>,
@@ -569,6 +572,7 @@ impl SvoGi {
         set: vk::DescriptorSet,
         linear: vk::Sampler,
         frames_in_flight: usize,
+        full_update: bool,
     ) -> Result<Self> {
         check_depth(depth)?;
         let grid = Grid::around(scene, 1 << depth);
@@ -610,6 +614,7 @@ impl SvoGi {
             bricks: bricks::BrickPasses::new(ctx, layouts)?,
             report: None,
             moving: scene.is_animated(),
+            full_update,
             frame_counters: (0..frames_in_flight)
                 .map(|i| {
                     let mut buffer = Buffer::new(
@@ -628,9 +633,9 @@ impl SvoGi {
         })
     }
 
-    /// Whether the scene has moving meshes (the octree is rebuilt every frame).
+    /// Whether the octree is rebuilt every frame (moving meshes, or `--full-update`).
     pub fn moving(&self) -> bool {
-        self.moving
+        self.moving || self.full_update
     }
 
     /// The occupied leaf voxels: the indirect dispatch of voxel shading and bounces.
@@ -868,7 +873,12 @@ impl SvoGi {
         }
         let ctx = &self.ctx;
         let report = self.report.as_ref().context("the octree was not built")?;
-        let statics = report.counters.static_fragment_count;
+        // With a full update no fragment is kept.
+        let statics = if self.full_update {
+            0
+        } else {
+            report.counters.static_fragment_count
+        };
         // The fragment fields, the node counts and the overflow bits.
         let head = [
             statics.div_ceil(layout::SVO_GROUP_SIZE),
@@ -895,8 +905,13 @@ impl SvoGi {
             vk::PipelineStageFlags2::FRAGMENT_SHADER,
         );
         timer.begin(cmd, "fragments");
+        let meshes = if self.full_update {
+            Meshes::All
+        } else {
+            Meshes::Moving
+        };
         self.voxelize
-            .record(ctx, cmd, draw, set, self.grid.resolution, Meshes::Moving);
+            .record(ctx, cmd, draw, set, self.grid.resolution, meshes);
         stage_barrier(
             ctx,
             cmd,

@@ -625,6 +625,29 @@ fn bricks_filter_and_borders_match_cpu() {
     assert_eq!(ctx.validation_messages(), 0);
 }
 
+/// Nodes per level, and the leaf voxels with their packed albedo (sorted), as they are
+/// after the last frame.
+#[allow(clippy::type_complexity)]
+fn leaf_snapshot(r: &Renderer) -> (Vec<u32>, Vec<([u32; 3], u32)>) {
+    let svo = r.gi().unwrap().octree().unwrap();
+    let d = download(svo);
+    let albedo = svo.download_leaf_attribute(0).unwrap();
+    let side = svo.pools.leaf_side;
+    let edge = side * layout::SVO_ATTRIBUTE_BRICK;
+    let mut voxels = Vec::new();
+    for (_, brick, c, k) in brick_voxels(&d, svo.depth as usize - 1) {
+        let o = [brick % side, (brick / side) % side, brick / (side * side)];
+        let t: [u32; 3] = std::array::from_fn(|a| o[a] * layout::SVO_ATTRIBUTE_BRICK + k[a]);
+        let word = albedo[(t[0] + edge * (t[1] + edge * t[2])) as usize];
+        if word != 0 {
+            voxels.push((std::array::from_fn::<u32, 3, _>(|a| 2 * c[a] + k[a]), word));
+        }
+    }
+    voxels.sort_unstable();
+    let nodes: Vec<u32> = d.levels.iter().map(|l| l.1).collect();
+    (nodes, voxels)
+}
+
 /// A mesh moving across the box leaves no nodes or voxels behind: after frames at three
 /// times, the octree (nodes per level, leaf voxels and their albedo) equals a fresh build
 /// at the last time, and differs from the first time's.
@@ -639,27 +662,11 @@ fn moving_mesh_leaves_no_nodes_behind() {
     let (ctx, moved) = render_frames(scene.clone(), settings.clone(), &[0.0, 0.5, 1.0]);
     let (_, fresh) = render_frames(scene.clone(), settings.clone(), &[1.0]);
     let (_, start) = render_frames(scene, settings, &[0.0]);
-    // Leaf voxels with their albedo, and nodes per level.
-    let snapshot = |r: &Renderer| {
-        let svo = r.gi().unwrap().octree().unwrap();
-        let d = download(svo);
-        let albedo = svo.download_leaf_attribute(0).unwrap();
-        let side = svo.pools.leaf_side;
-        let edge = side * layout::SVO_ATTRIBUTE_BRICK;
-        let mut voxels = Vec::new();
-        for (_, brick, c, k) in brick_voxels(&d, svo.depth as usize - 1) {
-            let o = [brick % side, (brick / side) % side, brick / (side * side)];
-            let t: [u32; 3] = std::array::from_fn(|a| o[a] * layout::SVO_ATTRIBUTE_BRICK + k[a]);
-            let word = albedo[(t[0] + edge * (t[1] + edge * t[2])) as usize];
-            if word != 0 {
-                voxels.push((std::array::from_fn::<u32, 3, _>(|a| 2 * c[a] + k[a]), word));
-            }
-        }
-        voxels.sort_unstable();
-        let nodes: Vec<u32> = d.levels.iter().map(|l| l.1).collect();
-        (nodes, voxels)
-    };
-    let (moved, fresh, start) = (snapshot(&moved), snapshot(&fresh), snapshot(&start));
+    let (moved, fresh, start) = (
+        leaf_snapshot(&moved),
+        leaf_snapshot(&fresh),
+        leaf_snapshot(&start),
+    );
     eprintln!(
         "nodes per level: moved {:?}, fresh {:?}, start {:?}; leaf voxels {} / {} / {}",
         moved.0,
@@ -680,4 +687,22 @@ fn moving_mesh_leaves_no_nodes_behind() {
     );
     assert_eq!(ctx.validation_messages(), 0);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `--full-update` voxelizes every mesh and rebuilds the octree every frame: the same
+/// octree as the build that keeps it.
+#[test]
+fn full_update_rebuilds_the_same_octree() {
+    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+        return;
+    };
+    let scene = Scene::load(&path, &LoadOptions::REFERENCE).unwrap();
+    let structure = VoxelStructure::Octree { capacities: None };
+    let (ctx, full) = render_frames(scene.clone(), gi_settings(64, structure, true), &[0.0, 0.5]);
+    let (_, kept) = render_frames(scene, gi_settings(64, structure, false), &[0.0, 0.5]);
+    let (full, kept) = (leaf_snapshot(&full), leaf_snapshot(&kept));
+    eprintln!("nodes per level {:?}, {} leaf voxels", full.0, full.1.len());
+    assert_eq!(full.0, kept.0);
+    assert!(full.1 == kept.1, "leaf voxels or albedo differ");
+    assert_eq!(ctx.validation_messages(), 0);
 }
