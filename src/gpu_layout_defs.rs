@@ -120,6 +120,8 @@ gpu_layout! {
         BINDING_SVO_SUMS = 27;
         /// Words per leaf voxel in the sums buffer.
         SVO_SUM_WORDS = 10;
+        /// SVO passes (set 2): the light each leaf voxel gathered in the last frame, kept across an octree rebuilt around moving meshes (which assigns new bricks): two hash tables of `carry_capacity` entries (key = voxel x | y << 10 | z << 20, plus 1; then the RGB floats), `uint[]` storage buffer.
+        BINDING_SVO_CARRY = 29;
         /// Edge of a leaf attribute brick (albedo, normal, emission, direct light): the leaf's 2x2x2 voxels.
         SVO_ATTRIBUTE_BRICK = 2;
         /// Edge of a radiance brick: the node's 2x2x2 voxels and a border of one voxel copied from the neighbours, so that trilinear filtering inside the node needs no other brick.
@@ -352,10 +354,10 @@ gpu_layout! {
         uint leaf_voxel_capacity,
         /// Fragments of the static meshes, listed first (the moving meshes' follow).
         uint static_fragment_count,
-        /// Unused.
-        uint pad0,
-        /// Unused.
-        uint pad1,
+        /// Entries of each of the two carry tables (a power of two; 0: no carry).
+        uint carry_capacity,
+        /// The carry table this frame writes (the other holds last frame's).
+        uint carry_parity,
         /// Unused.
         uint pad2,
     }

@@ -33,6 +33,9 @@ layout(set = SET_PASS, binding = BINDING_SVO_NEIGHBOURS, std430) buffer Neighbou
 layout(set = SET_PASS, binding = BINDING_SVO_SUMS, std430) buffer SumsBlock {
     uint leaf_sums[];
 };
+layout(set = SET_PASS, binding = BINDING_SVO_CARRY, std430) buffer CarryBlock {
+    uint carry[];
+};
 
 // Mask of a child entry's tile index.
 #define SVO_CHILD_MASK (~SVO_SUBDIVIDE)
@@ -93,6 +96,46 @@ bool leaf_texel(uvec3 v, out ivec3 texel) {
     uint side = counters.leaf_pool_side;
     texel = ivec3(brick % side, (brick / side) % side, brick / (side * side)) * int(SVO_ATTRIBUTE_BRICK) + ivec3(v & 1u);
     return true;
+}
+
+// The carried light tables (open addressing, linear probing; 4 words an entry): the
+// light a voxel gathered last frame, found by its coordinates after the octree was rebuilt.
+uint carry_slot(uint key, uint probe) {
+    uint h = key * 2654435761u;
+    return (h ^ (h >> 15)) + probe & (counters.carry_capacity - 1u);
+}
+
+// Records what voxel v gathered this frame.
+void carry_store(uvec3 v, vec3 gathered) {
+    uint key = pack_coord(v) + 1u;
+    uint base = counters.carry_parity * counters.carry_capacity;
+    for (uint probe = 0u; probe < counters.carry_capacity; probe++) {
+        uint entry = base + carry_slot(key, probe);
+        uint found = atomicCompSwap(carry[4u * entry], 0u, key);
+        if (found == 0u || found == key) {
+            carry[4u * entry + 1u] = floatBitsToUint(gathered.r);
+            carry[4u * entry + 2u] = floatBitsToUint(gathered.g);
+            carry[4u * entry + 3u] = floatBitsToUint(gathered.b);
+            return;
+        }
+    }
+}
+
+// What voxel v gathered last frame (zero if it was not there).
+vec3 carry_load(uvec3 v) {
+    uint key = pack_coord(v) + 1u;
+    uint base = (counters.carry_parity ^ 1u) * counters.carry_capacity;
+    for (uint probe = 0u; probe < counters.carry_capacity; probe++) {
+        uint entry = base + carry_slot(key, probe);
+        uint found = carry[4u * entry];
+        if (found == key) {
+            return uintBitsToFloat(uvec3(carry[4u * entry + 1u], carry[4u * entry + 2u], carry[4u * entry + 3u]));
+        }
+        if (found == 0u) {
+            break;
+        }
+    }
+    return vec3(0.0);
 }
 
 // The corner texel of brick `slot` in a pool of `side`³ bricks of `edge`³ texels.

@@ -868,8 +868,9 @@ impl VoxelGi {
     /// previous frame's filtered radiance, so bounces accumulate over frames at the cost
     /// of one (moving light takes a few frames to settle in the indirect light).
     ///
-    /// With moving meshes the octree is rebuilt every frame, its bricks are assigned
-    /// anew, and every frame computes all bounces. `slot` is the frame's slot in flight.
+    /// With moving meshes the octree is rebuilt every frame and its bricks are assigned
+    /// anew; the light its voxels gathered is carried over by voxel (`crate::svo`), so
+    /// bounces still accumulate one per frame. `slot` is the frame's slot in flight.
     pub fn record_update(
         &mut self,
         cmd: vk::CommandBuffer,
@@ -880,6 +881,7 @@ impl VoxelGi {
         let ctx = &self.ctx;
         let n = self.grid.resolution;
         let set = self.set;
+        let mut rebuilt = false;
         let list = match &mut self.voxels {
             Voxels::Dense(dense) => {
                 dense.record_voxelize(ctx, cmd, timer, draw, set, n);
@@ -889,7 +891,7 @@ impl VoxelGi {
             Voxels::Octree(svo) => {
                 if svo.moving() {
                     svo.record_moving(cmd, timer, draw, set, slot)?;
-                    self.history = false;
+                    rebuilt = true;
                 }
                 svo.voxel_list()
             }
@@ -918,7 +920,9 @@ impl VoxelGi {
             Voxels::Octree(svo) => svo.record_filter(cmd, draw.frame_set, set),
         };
         let bounces = if self.history { 1 } else { self.bounces - 1 };
-        if !self.history {
+        // A rebuilt octree's bricks are new: its voxel shading started from the light
+        // carried by voxel, which is filtered before the bounce.
+        if !self.history || rebuilt {
             timer.begin(cmd, "filter");
             compute_to_compute(ctx, cmd);
             filter(&self.voxels);

@@ -237,6 +237,10 @@ struct Pools {
     voxel_list: Buffer,
     /// Per leaf voxel, its fragments' attribute sums and count (`SVO_SUM_WORDS` words).
     sums: Buffer,
+    /// Two tables of `carry_capacity` entries: the light each leaf voxel gathered, kept
+    /// across rebuilds of the octree (only when it is rebuilt every frame).
+    carry: Buffer,
+    carry_capacity: u32,
     /// The images have been cleared once (they are in GENERAL layout since, read and
     /// written by any pass of earlier frames).
     cleared: std::cell::Cell<bool>,
@@ -255,7 +259,9 @@ const RADIANCE_USE: ImageUse = ImageUse {
 };
 
 impl Pools {
-    fn new(ctx: &Arc<Context>, capacities: Capacities) -> Result<Self> {
+    /// `carry`: the octree is rebuilt every frame, and its voxels' gathered light is
+    /// carried from one frame to the next.
+    fn new(ctx: &Arc<Context>, capacities: Capacities, carry: bool) -> Result<Self> {
         let device_limit = u64::from(ctx.properties.limits.max_storage_buffer_range);
         let max_3d = ctx.properties.limits.max_image_dimension3_d;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER
@@ -303,8 +309,20 @@ impl Pools {
             usage | vk::ImageUsageFlags::SAMPLED,
         );
         directional_desc.extent.width = 6 * interior_edge;
-        let list_words =
-            2 * u64::from(layout::SVO_ATTRIBUTE_BRICK).pow(3) * u64::from(capacities.leaf_bricks);
+        // A leaf's first sum sits in bits 8-30 of its child entry.
+        ensure!(
+            capacities.leaf_voxels < 1 << 23,
+            "the SVO needs sums for {} leaf voxels, more than the 2^23 its nodes can point \
+             to: use a smaller --octree-depth",
+            capacities.leaf_voxels
+        );
+        let list_words = 2 * u64::from(capacities.leaf_voxels);
+        // Half full at most, for short probes.
+        let carry_capacity = if carry {
+            (2 * capacities.leaf_voxels).next_power_of_two()
+        } else {
+            0
+        };
         Ok(Self {
             capacities,
             nodes: buffer("svo nodes", 4 * nodes, vk::BufferUsageFlags::empty())?,
@@ -337,6 +355,12 @@ impl Pools {
                 vk::BufferUsageFlags::empty(),
             )?,
             cleared: std::cell::Cell::new(false),
+            carry_capacity,
+            carry: buffer(
+                "svo carry",
+                2 * 16 * u64::from(carry_capacity.max(1)),
+                vk::BufferUsageFlags::empty(),
+            )?,
         })
     }
 
@@ -352,6 +376,7 @@ impl Pools {
             .buffer(layout::BINDING_SVO_NEIGHBOURS, storage, self.neighbours.raw)
             .buffer(layout::BINDING_GI_VOXEL_LIST, storage, self.voxel_list.raw)
             .buffer(layout::BINDING_SVO_SUMS, storage, self.sums.raw)
+            .buffer(layout::BINDING_SVO_CARRY, storage, self.carry.raw)
             .storage_image(layout::BINDING_GI_ALBEDO, albedo.view)
             .storage_image(layout::BINDING_GI_NORMAL, normal.view)
             .storage_image(layout::BINDING_GI_EMISSION, emission.view)
@@ -405,6 +430,7 @@ impl Pools {
             ("svo_brick_pool", bricks),
             ("svo_voxel_list", self.voxel_list.size),
             ("svo_fragment_sums", self.sums.size),
+            ("svo_carry", self.carry.size),
         ]
     }
 }
@@ -523,6 +549,7 @@ pub fn bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_SVO_NODE_BRICKS, storage, all),
         Binding::new(layout::BINDING_SVO_NEIGHBOURS, storage, all),
         Binding::new(layout::BINDING_SVO_SUMS, storage, all),
+        Binding::new(layout::BINDING_SVO_CARRY, storage, all),
         Binding::new(
             layout::BINDING_SVO_DIRECTIONAL_STORAGE,
             vk::DescriptorType::STORAGE_IMAGE,
@@ -549,6 +576,8 @@ pub struct SvoGi {
     moving: bool,
     /// `--full-update`: every mesh is voxelized again every frame too.
     full_update: bool,
+    /// The carry table the current frame writes.
+    carry_parity: u32,
     /// Per frame in flight: its counters, read when the slot comes round again.
     frame_counters: Vec<Buffer>,
     /// The radiance pools' sampler (the GI set refers to it).
@@ -596,7 +625,7 @@ impl SvoGi {
             .apply();
         let fragments = Fragments::new(ctx, capacities.fragments)?;
         fragments.write_set(ctx, set);
-        let pools = Pools::new(ctx, capacities)?;
+        let pools = Pools::new(ctx, capacities, scene.is_animated() || full_update)?;
         pools.write_set(ctx, set, linear);
         Ok(Self {
             grid,
@@ -615,6 +644,7 @@ impl SvoGi {
             report: None,
             moving: scene.is_animated(),
             full_update,
+            carry_parity: 0,
             frame_counters: (0..frames_in_flight)
                 .map(|i| {
                     let mut buffer = Buffer::new(
@@ -697,12 +727,23 @@ impl SvoGi {
                         // margin moving meshes need) and build the octree once more.
                         log::info!("SVO pools fitted to what they hold: {fit:?}");
                         fitted = true;
-                        self.pools = Pools::new(&self.ctx, fit).context("fitting the SVO pools")?;
+                        self.pools = Pools::new(&self.ctx, fit, self.moving())
+                            .context("fitting the SVO pools")?;
                         self.pools.write_set(&self.ctx, set, self.linear);
                         continue;
                     }
                     passes.extend(timings);
                     if phase == Phase::Octree {
+                        // Nothing carried yet.
+                        let carry = self.pools.carry.raw;
+                        OneShot::new(&self.ctx)?.run("clear svo carry", |cmd| {
+                            unsafe {
+                                self.ctx
+                                    .device
+                                    .cmd_fill_buffer(cmd, carry, 0, vk::WHOLE_SIZE, 0)
+                            };
+                            Ok(())
+                        })?;
                         self.report = Some(BuildReport {
                             counters,
                             levels,
@@ -734,7 +775,8 @@ impl SvoGi {
                     self.fragments.write_set(&self.ctx, set);
                     self.pools.capacities.fragments = grown.fragments;
                 } else {
-                    self.pools = Pools::new(&self.ctx, grown).context("growing the SVO pools")?;
+                    self.pools = Pools::new(&self.ctx, grown, self.moving())
+                        .context("growing the SVO pools")?;
                     self.pools.write_set(&self.ctx, set, self.linear);
                 }
             }
@@ -871,6 +913,7 @@ impl SvoGi {
             self.frame_counters[slot].write(0, &[0; COUNTERS_BYTES]);
             self.build(draw, set)?;
         }
+        self.carry_parity ^= 1;
         let ctx = &self.ctx;
         let report = self.report.as_ref().context("the octree was not built")?;
         // With a full update no fragment is kept.
@@ -904,6 +947,17 @@ impl SvoGi {
             bytemuck::cast_slice(&head),
             vk::PipelineStageFlags2::FRAGMENT_SHADER,
         );
+        // The carry table this frame writes; the other holds what last frame gathered.
+        let half = 16 * u64::from(self.pools.carry_capacity);
+        unsafe {
+            ctx.device.cmd_fill_buffer(
+                cmd,
+                self.pools.carry.raw,
+                u64::from(self.carry_parity) * half,
+                half,
+                0,
+            )
+        };
         timer.begin(cmd, "fragments");
         let meshes = if self.full_update {
             Meshes::All
@@ -949,6 +1003,8 @@ impl SvoGi {
             leaf_pool_side: p.leaf_side,
             interior_pool_side: p.interior_side,
             leaf_voxel_capacity: c.leaf_voxels,
+            carry_capacity: p.carry_capacity,
+            carry_parity: self.carry_parity,
             ..Default::default()
         };
         let root = SvoLevel {

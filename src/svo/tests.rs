@@ -706,3 +706,58 @@ fn full_update_rebuilds_the_same_octree() {
     assert!(full.1 == kept.1, "leaf voxels or albedo differ");
     assert_eq!(ctx.validation_messages(), 0);
 }
+
+/// Around moving meshes the octree is rebuilt every frame with new bricks, and the light
+/// each voxel gathered is carried over by voxel: frames at a fixed time add one bounce
+/// each and converge to what one frame with every bounce gives.
+#[test]
+fn carried_light_converges_to_all_bounces() {
+    let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("voxcone-svo-carry-{}", std::process::id()));
+    let scene = moving_cube_scene(&cornell, &dir);
+    let settings = gi_settings(64, VoxelStructure::Octree { capacities: None }, false);
+    let (ctx, carried) = render_frames(scene.clone(), settings.clone(), &[1.0; 9]);
+    let (_, once) = render_frames(scene, settings, &[1.0]);
+    // Total leaf radiance (the bounces add light; direct light is the same in both).
+    let total = |r: &Renderer| -> [f64; 3] {
+        let svo = r.gi().unwrap().octree().unwrap();
+        let d = download(svo);
+        let image = &svo.pools.leaf_radiance;
+        let bytes = crate::vk::read_back_image(
+            &svo.ctx,
+            image,
+            0,
+            image.desc.extent,
+            8,
+            super::RADIANCE_USE,
+        )
+        .unwrap();
+        let pool = Pool {
+            texels: halves(&bytes),
+            width: image.desc.extent.width,
+            edge: image.desc.extent.height,
+        };
+        let mut sum = [0.0f64; 3];
+        for (_, brick, _, k) in brick_voxels(&d, svo.depth as usize - 1) {
+            let v = pool.at(brick_texel(
+                brick,
+                svo.pools.leaf_side,
+                k.map(|x| x as i32),
+                0,
+            ));
+            for c in 0..3 {
+                sum[c] += f64::from(v[c]);
+            }
+        }
+        sum
+    };
+    let (a, b) = (total(&carried), total(&once));
+    eprintln!("total leaf radiance: carried over 9 frames {a:?}, one frame of all bounces {b:?}");
+    for c in 0..3 {
+        assert!((a[c] / b[c] - 1.0).abs() < 0.03, "{a:?} against {b:?}");
+    }
+    assert_eq!(ctx.validation_messages(), 0);
+    std::fs::remove_dir_all(&dir).ok();
+}

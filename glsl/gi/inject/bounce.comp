@@ -31,5 +31,10 @@ void main() {
     float offset = 1.5 * gi.origin.w;
     vec3 gathered = gather_diffuse(p, p + n * offset, n, BOUNCE_CONES, 1.0, false).rgb;
     vec4 direct = imageLoad(voxel_direct, voxel);
+#ifdef VOXELS_SVO
+    if (counters.carry_capacity > 0u) {
+        carry_store(uvec3(entry.voxel), gathered);
+    }
+#endif
     imageStore(voxel_radiance_out, entry.radiance_texel, vec4(direct.rgb + albedo.rgb / 255.0 * gathered, direct.a));
 }

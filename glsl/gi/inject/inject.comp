@@ -101,6 +101,13 @@ void main() {
         imageStore(voxel_normal, voxel, uvec4(pack_rgba8(vec4((lit * 0.5 + 0.5) * 255.0, packed_normal.a))));
     }
     vec4 radiance = vec4(rho / PI * e + emission, 1.0);
-    imageStore(voxel_radiance, entry.radiance_texel, radiance);
     imageStore(voxel_direct, voxel, radiance);
+#ifdef VOXELS_SVO
+    // An octree rebuilt around moving meshes starts from the light its voxels gathered
+    // last frame, as the dense grid's bounces start from last frame's filtered light.
+    if (counters.carry_capacity > 0u) {
+        radiance.rgb += rho * carry_load(uvec3(entry.voxel));
+    }
+#endif
+    imageStore(voxel_radiance, entry.radiance_texel, radiance);
 }
