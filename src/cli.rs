@@ -94,6 +94,10 @@ pub struct CommonArgs {
     /// Cone step as a fraction of the cone's diameter (beta), 0.05 to 2 [default: 0.5].
     #[arg(long)]
     pub step_factor: Option<f32>,
+    /// Step the diffuse cones level by level, each sample twice as far and wide as the
+    /// last (Dřínovský's sampling of wide cones), instead of by the step factor.
+    #[arg(long)]
+    pub wide_steps_by_level: bool,
     /// Diffuse cones per gather, 1 to 16: one along the normal, the rest in a ring at 60
     /// degrees [default: 6].
     #[arg(long)]
@@ -279,6 +283,8 @@ impl CommonArgs {
                 .step_factor
                 .or(scene.step_factor)
                 .unwrap_or(d.step_factor),
+            wide_steps_by_level: self.wide_steps_by_level
+                || scene.wide_steps_by_level.unwrap_or(d.wide_steps_by_level),
             accumulate_bounces: !self.no_accumulate,
             shadow_aperture_deg: self
                 .shadow_aperture

@@ -300,8 +300,8 @@ gpu_layout! {
         float shadow_tan_half,
         /// Occluders this far away (world units) occlude half as much as adjacent ones.
         float ao_distance,
-        /// Unused.
-        uint pad0,
+        /// 1: the diffuse (wide) cones step level by level, each sample twice as wide as the last (Dřínovský 2013, 5.6); 0: by `step_factor` of their diameter, as the other cones.
+        uint wide_steps_by_level,
         /// Unused.
         uint pad1,
     }

@@ -90,7 +90,10 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surfa
         } else {
             s = sample_voxels(uvw, dir, lod);
         }
-        float step_length = diameter * gi.step_factor;
+        // Wide cones may instead step level by level: each sample at twice the last's
+        // distance, so twice as wide, reading the next coarser level (min_lod marks them).
+        float step_length = (gi.wide_steps_by_level != 0u && min_lod >= 1.0) ? max(dist, diameter * gi.step_factor)
+                                                                              : diameter * gi.step_factor;
         float next_lod;
         float next_diameter;
         float next_footprint;

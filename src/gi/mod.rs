@@ -73,6 +73,9 @@ pub struct ConeSettings {
     pub diffuse_cones: u32,
     /// Step length as a fraction of the cone diameter (beta).
     pub step_factor: f32,
+    /// The diffuse cones step level by level (each sample twice as far, so twice as wide)
+    /// instead of by `step_factor` of their diameter.
+    pub wide_steps_by_level: bool,
     /// Light bounces between voxels: 1 is direct light on the voxels only.
     pub bounces: u32,
     /// Indirect light is traced on one pixel of each `indirect_scale`² block and
@@ -171,6 +174,7 @@ impl Default for ConeSettings {
             diffuse_aperture_deg: 60.0,
             diffuse_cones: 6,
             step_factor: 0.5,
+            wide_steps_by_level: false,
             bounces: 8,
             indirect_scale: None,
             accumulate_bounces: true,
@@ -681,6 +685,7 @@ impl VoxelGi {
             diffuse_cones: cones.diffuse_cones.clamp(1, 16),
             shadow_tan_half: (cones.shadow_aperture_deg.to_radians() * 0.5).tan(),
             ao_distance: cones.ao_distance_voxels.max(1e-3) * grid.voxel_size,
+            wide_steps_by_level: u32::from(cones.wide_steps_by_level),
             ..Default::default()
         };
         let uniforms = Buffer::with_data(

@@ -51,6 +51,7 @@
 //! diffuse_cones = 6              # --diffuse-cones
 //! diffuse_aperture_deg = 60.0    # --diffuse-aperture
 //! step_factor = 0.5              # --step-factor
+//! wide_steps_by_level = false    # --wide-steps-by-level
 //! bounces = 8                    # --bounces
 //! indirect_scale = 2             # --indirect-scale (default: by image height)
 //! shadow_cones = false           # --shadow-cones
