@@ -9,6 +9,25 @@ use ash::vk;
 use crate::gpu_layout::{self as layout, VoxelListHeader};
 use crate::vk::{groups_3d, memory_barrier, update_buffer, Buffer, Context, Pipeline};
 
+/// Empties an occupied-voxel list (`glsl/gi/voxel_list.glsl`) before the compute pass
+/// that fills it: no entries, and an indirect dispatch of no workgroups.
+pub fn reset_voxel_list(ctx: &Context, cmd: vk::CommandBuffer, list: vk::Buffer) {
+    let empty = VoxelListHeader {
+        groups_x: 0,
+        groups_y: 1,
+        groups_z: 1,
+        count: 0,
+    };
+    update_buffer(
+        ctx,
+        cmd,
+        list,
+        0,
+        bytemuck::bytes_of(&empty),
+        vk::PipelineStageFlags2::COMPUTE_SHADER,
+    );
+}
+
 pub struct CompactPass {
     pipeline: Pipeline,
     /// `VoxelListHeader` then one `u32` per voxel of the grid (all may be occupied).
@@ -68,20 +87,7 @@ impl CompactPass {
                 vk::AccessFlags2::TRANSFER_WRITE,
             ),
         );
-        let empty = VoxelListHeader {
-            groups_x: 0,
-            groups_y: 1,
-            groups_z: 1,
-            count: 0,
-        };
-        update_buffer(
-            ctx,
-            cmd,
-            self.list.raw,
-            0,
-            bytemuck::bytes_of(&empty),
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-        );
+        reset_voxel_list(ctx, cmd, self.list.raw);
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
         self.pipeline
             .dispatch(cmd, &sets, groups_3d(n, layout::VOXEL_GROUP_SIZE));

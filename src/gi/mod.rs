@@ -8,6 +8,7 @@
 //! the direct lighting).
 
 mod compact;
+pub(crate) use compact::reset_voxel_list;
 mod cone_trace;
 mod debug;
 mod filter;

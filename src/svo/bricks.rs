@@ -16,7 +16,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
-use super::octree::level_offset;
+use super::octree::{dispatch_for_level, level_offset};
 use crate::gi::compute_to_compute;
 use crate::gpu_layout::SvoPush;
 use crate::vk::{Context, Pipeline};
@@ -60,7 +60,8 @@ impl BrickPasses {
         counters: vk::Buffer,
         leaf_level: u32,
     ) {
-        self.dispatch_level(&self.list, cmd, sets, counters, leaf_level);
+        let offset = level_offset(leaf_level);
+        dispatch_for_level(&self.list, cmd, sets, leaf_level, counters, offset);
     }
 
     /// Borders of the leaves, then each level above filtered from the one below and
@@ -73,28 +74,21 @@ impl BrickPasses {
         counters: vk::Buffer,
         depth: u32,
     ) {
-        self.dispatch_level(&self.apron, cmd, sets, counters, depth - 1);
-        for level in (0..depth - 1).rev() {
+        let leaves = depth - 1;
+        dispatch_for_level(
+            &self.apron,
+            cmd,
+            sets,
+            leaves,
+            counters,
+            level_offset(leaves),
+        );
+        for level in (0..leaves).rev() {
+            let offset = level_offset(level);
             compute_to_compute(ctx, cmd);
-            self.dispatch_level(&self.filter, cmd, sets, counters, level);
+            dispatch_for_level(&self.filter, cmd, sets, level, counters, offset);
             compute_to_compute(ctx, cmd);
-            self.dispatch_level(&self.apron, cmd, sets, counters, level);
+            dispatch_for_level(&self.apron, cmd, sets, level, counters, offset);
         }
-    }
-
-    fn dispatch_level(
-        &self,
-        pipeline: &Pipeline,
-        cmd: vk::CommandBuffer,
-        sets: &[(u32, vk::DescriptorSet)],
-        counters: vk::Buffer,
-        level: u32,
-    ) {
-        let push = SvoPush {
-            level,
-            ..Default::default()
-        };
-        pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
-        pipeline.dispatch_indirect(cmd, sets, counters, level_offset(level));
     }
 }

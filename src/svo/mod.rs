@@ -19,7 +19,7 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use crate::gi::voxelize::{Meshes, VoxelizePass};
-use crate::gi::{compute_to_compute, Grid};
+use crate::gi::{compute_to_compute, reset_voxel_list, Grid};
 use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel, VoxelListHeader};
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
@@ -1069,25 +1069,18 @@ impl SvoGi {
         timer.end(cmd);
 
         timer.begin(cmd, "voxel list");
-        let empty = VoxelListHeader {
-            groups_x: 0,
-            groups_y: 1,
-            groups_z: 1,
-            count: 0,
-        };
-        update_buffer(
-            ctx,
-            cmd,
-            p.voxel_list.raw,
-            0,
-            bytemuck::bytes_of(&empty),
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-        );
+        reset_voxel_list(ctx, cmd, p.voxel_list.raw);
         self.bricks
             .record_list(cmd, &sets, counters, self.depth - 1);
-        // Voxel shading writes only the listed voxels: the others must read zero.
-        for image in [&p.leaf_direct, &p.leaf_radiance, &p.directional] {
-            clear_to_zero(ctx, cmd, image, p.last_use(), RADIANCE_USE);
+        // Voxel shading writes only the listed voxels, whose bricks' other voxels cones and
+        // the filter read: they must be zero. The direct light is read only at listed
+        // voxels, and the filter and the borders write every texel of the interior bricks
+        // in use: those two need clearing only once, out of their initial layout.
+        clear_to_zero(ctx, cmd, &p.leaf_radiance, p.last_use(), RADIANCE_USE);
+        if !p.cleared.get() {
+            for image in [&p.leaf_direct, &p.directional] {
+                clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, RADIANCE_USE);
+            }
         }
         p.cleared.set(true);
         stage_barrier(

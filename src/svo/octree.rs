@@ -19,6 +19,25 @@ pub fn level_offset(level: u32) -> vk::DeviceSize {
         as vk::DeviceSize
 }
 
+/// Pushes `level` to `pipeline`, binds it with `sets` and dispatches the workgroup counts
+/// at byte `offset` of `counters` (0: one invocation per fragment; [`level_offset`]: one
+/// per node of a level).
+pub fn dispatch_for_level(
+    pipeline: &Pipeline,
+    cmd: vk::CommandBuffer,
+    sets: &[(u32, vk::DescriptorSet)],
+    level: u32,
+    counters: vk::Buffer,
+    offset: vk::DeviceSize,
+) {
+    let push = SvoPush {
+        level,
+        ..Default::default()
+    };
+    pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
+    pipeline.dispatch_indirect(cmd, sets, counters, offset);
+}
+
 pub struct OctreePasses {
     flag: Pipeline,
     alloc: Pipeline,
@@ -73,61 +92,36 @@ impl OctreePasses {
         counters: vk::Buffer,
         depth: u32,
     ) {
-        let compute = vk::ShaderStageFlags::COMPUTE;
         for level in 0..depth {
-            let push = SvoPush {
-                level,
-                ..Default::default()
-            };
             timer.begin(cmd, &format!("flag {level}"));
-            self.flag.bind(cmd, sets);
-            self.flag.push(cmd, compute, &push);
-            unsafe { ctx.device.cmd_dispatch_indirect(cmd, counters, 0) };
+            dispatch_for_level(&self.flag, cmd, sets, level, counters, 0);
             compute_to_compute(ctx, cmd);
             timer.end(cmd);
 
             timer.begin(cmd, &format!("alloc {level}"));
-            self.alloc.bind(cmd, sets);
-            self.alloc.push(cmd, compute, &push);
-            unsafe {
-                ctx.device
-                    .cmd_dispatch_indirect(cmd, counters, level_offset(level))
-            };
+            dispatch_for_level(&self.alloc, cmd, sets, level, counters, level_offset(level));
             compute_to_compute(ctx, cmd);
             timer.end(cmd);
 
             if level + 1 < depth {
-                let child = SvoPush {
-                    level: level + 1,
+                let child = level + 1;
+                timer.begin(cmd, &format!("init {child}"));
+                let push = SvoPush {
+                    level: child,
                     ..Default::default()
                 };
-                timer.begin(cmd, &format!("init {}", level + 1));
-                self.level.bind(cmd, sets);
-                self.level.push(cmd, compute, &child);
-                unsafe { ctx.device.cmd_dispatch(cmd, 1, 1, 1) };
+                self.level.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
+                self.level.dispatch(cmd, sets, [1, 1, 1]);
                 compute_to_indirect(ctx, cmd);
-                self.init.bind(cmd, sets);
-                self.init.push(cmd, compute, &child);
-                unsafe {
-                    ctx.device
-                        .cmd_dispatch_indirect(cmd, counters, level_offset(level + 1))
-                };
+                dispatch_for_level(&self.init, cmd, sets, child, counters, level_offset(child));
                 compute_to_compute(ctx, cmd);
                 timer.end(cmd);
             }
         }
         timer.begin(cmd, "neighbours");
-        self.neighbours.bind(cmd, sets);
         for level in 0..depth {
-            let push = SvoPush {
-                level,
-                ..Default::default()
-            };
-            self.neighbours.push(cmd, compute, &push);
-            unsafe {
-                ctx.device
-                    .cmd_dispatch_indirect(cmd, counters, level_offset(level))
-            };
+            let offset = level_offset(level);
+            dispatch_for_level(&self.neighbours, cmd, sets, level, counters, offset);
         }
         compute_to_compute(ctx, cmd);
         timer.end(cmd);
