@@ -42,7 +42,7 @@ pub enum GiMode {
     #[default]
     Dense,
     /// Voxel cone tracing on a sparse voxel octree built on the GPU, with bricks in 3D
-    /// textures (static scenes only for now).
+    /// textures.
     Svo,
 }
 

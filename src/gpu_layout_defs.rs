@@ -122,6 +122,8 @@ gpu_layout! {
         SVO_SUM_WORDS = 10;
         /// SVO passes (set 2): the light each leaf voxel gathered in the last frame, kept across an octree rebuilt around moving meshes (which assigns new bricks): two hash tables of `carry_capacity` entries (key = voxel x | y << 10 | z << 20, plus 1; then the RGB floats), `uint[]` storage buffer.
         BINDING_SVO_CARRY = 29;
+        /// SVO passes (set 2): the static part's child entries as the static build left them (Dřínovský 2013, 5.7): each frame restores them, and a static leaf that a moving mesh's fragments reach reads its own voxels' mask and sums from here, `uint[]` storage buffer.
+        BINDING_SVO_STATIC_NODES = 30;
         /// Edge of a leaf attribute brick (albedo, normal, emission, direct light): the leaf's 2x2x2 voxels.
         SVO_ATTRIBUTE_BRICK = 2;
         /// Edge of a radiance brick: the node's 2x2x2 voxels and a border of one voxel copied from the neighbours, so that trilinear filtering inside the node needs no other brick.
@@ -352,42 +354,58 @@ gpu_layout! {
         uint leaf_voxels,
         /// Leaf voxels the sums buffer holds.
         uint leaf_voxel_capacity,
-        /// Fragments of the static meshes, listed first (the moving meshes' follow).
-        uint static_fragment_count,
         /// Entries of each of the two carry tables (a power of two; 0: no carry).
         uint carry_capacity,
         /// The carry table this frame writes (the other holds last frame's).
         uint carry_parity,
+        /// The first fragment the octree passes read: 0 in a build, the static fragments' count in a frame (only the moving meshes' fragments are inserted).
+        uint fragment_base,
+        /// Nodes of the static part (built once, restored every frame; the dynamic part's follow). A static leaf that a frame's fragments reach is copied to a new brick and new sums.
+        uint static_node_count,
+        /// Leaf bricks of the static part: their attributes are kept; later bricks are filled every frame.
+        uint static_leaf_bricks,
         /// Unused.
         uint pad2,
+        /// Unused.
+        uint pad3,
+        /// Unused.
+        uint pad4,
     }
 
-    /// One level of the octree: its nodes are contiguous in the node pool.
+    /// One level of the octree: its nodes in two contiguous runs of the node pool, the static part's (built once) and those appended since (a build appends every level but the root; a frame appends the moving meshes' nodes after the static part).
     struct SvoLevel {
-        /// Indirect dispatch over the level's nodes: workgroups of `SVO_GROUP_SIZE`.
+        /// Indirect dispatch over the level's nodes, both runs: workgroups of `SVO_GROUP_SIZE`.
         uint groups_x,
         /// Indirect dispatch: 1.
         uint groups_y,
         /// Indirect dispatch: 1.
         uint groups_z,
-        /// Index of the level's first node.
+        /// Index of the level's first static node.
         uint first,
-        /// Nodes in the level.
+        /// Static nodes in the level.
         uint count,
+        /// Index of the level's first appended node.
+        uint appended_first,
+        /// Appended nodes in the level.
+        uint appended_count,
         /// Unused.
         uint pad0,
+        /// Indirect dispatch over the appended nodes only.
+        uint appended_groups_x,
+        /// Indirect dispatch: 1.
+        uint appended_groups_y,
+        /// Indirect dispatch: 1.
+        uint appended_groups_z,
         /// Unused.
         uint pad1,
-        /// Unused.
-        uint pad2,
     }
 
     /// Push constants of the octree passes that work on one level.
     struct SvoPush {
         /// The level.
         uint level,
-        /// Unused.
-        uint pad0,
+        /// 1: the pass runs over the level's appended nodes only.
+        uint appended_only,
         /// Unused.
         uint pad1,
         /// Unused.

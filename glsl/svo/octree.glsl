@@ -36,6 +36,9 @@ layout(set = SET_PASS, binding = BINDING_SVO_SUMS, std430) buffer SumsBlock {
 layout(set = SET_PASS, binding = BINDING_SVO_CARRY, std430) buffer CarryBlock {
     uint carry[];
 };
+layout(set = SET_PASS, binding = BINDING_SVO_STATIC_NODES, std430) readonly buffer StaticBlock {
+    uint static_children[];
+};
 
 // Mask of a child entry's tile index.
 #define SVO_CHILD_MASK (~SVO_SUBDIVIDE)

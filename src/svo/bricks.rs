@@ -16,7 +16,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
-use super::octree::{dispatch_for_level, level_offset};
+use super::octree::{dispatch_for_level, Over};
 use crate::gi::compute_to_compute;
 use crate::gpu_layout::SvoPush;
 use crate::vk::{Context, Pipeline};
@@ -60,8 +60,7 @@ impl BrickPasses {
         counters: vk::Buffer,
         leaf_level: u32,
     ) {
-        let offset = level_offset(leaf_level);
-        dispatch_for_level(&self.list, cmd, sets, leaf_level, counters, offset);
+        dispatch_for_level(&self.list, cmd, sets, leaf_level, counters, Over::Level);
     }
 
     /// Borders of the leaves, then each level above filtered from the one below and
@@ -75,20 +74,12 @@ impl BrickPasses {
         depth: u32,
     ) {
         let leaves = depth - 1;
-        dispatch_for_level(
-            &self.apron,
-            cmd,
-            sets,
-            leaves,
-            counters,
-            level_offset(leaves),
-        );
+        dispatch_for_level(&self.apron, cmd, sets, leaves, counters, Over::Level);
         for level in (0..leaves).rev() {
-            let offset = level_offset(level);
             compute_to_compute(ctx, cmd);
-            dispatch_for_level(&self.filter, cmd, sets, level, counters, offset);
+            dispatch_for_level(&self.filter, cmd, sets, level, counters, Over::Level);
             compute_to_compute(ctx, cmd);
-            dispatch_for_level(&self.apron, cmd, sets, level, counters, offset);
+            dispatch_for_level(&self.apron, cmd, sets, level, counters, Over::Level);
         }
     }
 }

@@ -27,6 +27,7 @@ use crate::vk::{
     clear_to_zero, copies_to_host_barrier, stage_barrier, update_buffer, Binding, Buffer, Context,
     GpuTimer, Image, ImageDesc, ImageUse, OneShot, SetWriter,
 };
+use octree::Over;
 
 /// Octree depths `--octree-depth` accepts: effective grids of 64³ to 1024³.
 pub const DEPTHS: std::ops::RangeInclusive<u32> = 6..=10;
@@ -241,6 +242,10 @@ struct Pools {
     /// across rebuilds of the octree (only when it is rebuilt every frame).
     carry: Buffer,
     carry_capacity: u32,
+    /// The static part's child entries and bricks as its build left them (only with
+    /// moving meshes): every frame restores them before it inserts the moving meshes.
+    static_children: Buffer,
+    static_bricks: Buffer,
     /// The images have been cleared once (they are in GENERAL layout since, read and
     /// written by any pass of earlier frames).
     cleared: std::cell::Cell<bool>,
@@ -259,9 +264,10 @@ const RADIANCE_USE: ImageUse = ImageUse {
 };
 
 impl Pools {
-    /// `carry`: the octree is rebuilt every frame, and its voxels' gathered light is
-    /// carried from one frame to the next.
-    fn new(ctx: &Arc<Context>, capacities: Capacities, carry: bool) -> Result<Self> {
+    /// `moving`: moving meshes are inserted into the octree every frame; the static
+    /// part is kept aside, and the voxels' gathered light is carried from one frame to
+    /// the next.
+    fn new(ctx: &Arc<Context>, capacities: Capacities, moving: bool) -> Result<Self> {
         let device_limit = u64::from(ctx.properties.limits.max_storage_buffer_range);
         let max_3d = ctx.properties.limits.max_image_dimension3_d;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER
@@ -318,7 +324,7 @@ impl Pools {
         );
         let list_words = 2 * u64::from(capacities.leaf_voxels);
         // Half full at most, for short probes.
-        let carry_capacity = if carry {
+        let carry_capacity = if moving {
             (2 * capacities.leaf_voxels).next_power_of_two()
         } else {
             0
@@ -361,6 +367,16 @@ impl Pools {
                 2 * 16 * u64::from(carry_capacity.max(1)),
                 vk::BufferUsageFlags::empty(),
             )?,
+            static_children: buffer(
+                "svo static nodes",
+                if moving { 4 * nodes } else { 4 },
+                vk::BufferUsageFlags::empty(),
+            )?,
+            static_bricks: buffer(
+                "svo static node bricks",
+                if moving { 4 * nodes } else { 4 },
+                vk::BufferUsageFlags::empty(),
+            )?,
         })
     }
 
@@ -377,6 +393,11 @@ impl Pools {
             .buffer(layout::BINDING_GI_VOXEL_LIST, storage, self.voxel_list.raw)
             .buffer(layout::BINDING_SVO_SUMS, storage, self.sums.raw)
             .buffer(layout::BINDING_SVO_CARRY, storage, self.carry.raw)
+            .buffer(
+                layout::BINDING_SVO_STATIC_NODES,
+                storage,
+                self.static_children.raw,
+            )
             .storage_image(layout::BINDING_GI_ALBEDO, albedo.view)
             .storage_image(layout::BINDING_GI_NORMAL, normal.view)
             .storage_image(layout::BINDING_GI_EMISSION, emission.view)
@@ -431,6 +452,10 @@ impl Pools {
             ("svo_voxel_list", self.voxel_list.size),
             ("svo_fragment_sums", self.sums.size),
             ("svo_carry", self.carry.size),
+            (
+                "svo_static_nodes",
+                self.static_children.size + self.static_bricks.size,
+            ),
         ]
     }
 }
@@ -526,7 +551,8 @@ impl BuildReport {
             ("build_wall_ms".to_string(), self.wall_ms),
         ];
         for (i, level) in self.levels.iter().enumerate() {
-            stats.push((format!("nodes_level_{i}"), f64::from(level.count)));
+            let nodes = level.count + level.appended_count;
+            stats.push((format!("nodes_level_{i}"), f64::from(nodes)));
         }
         stats
     }
@@ -550,6 +576,7 @@ pub fn bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_SVO_NEIGHBOURS, storage, all),
         Binding::new(layout::BINDING_SVO_SUMS, storage, all),
         Binding::new(layout::BINDING_SVO_CARRY, storage, all),
+        Binding::new(layout::BINDING_SVO_STATIC_NODES, storage, all),
         Binding::new(
             layout::BINDING_SVO_DIRECTIONAL_STORAGE,
             vk::DescriptorType::STORAGE_IMAGE,
@@ -571,9 +598,11 @@ pub struct SvoGi {
     octree: octree::OctreePasses,
     bricks: bricks::BrickPasses,
     report: Option<BuildReport>,
-    /// The scene has moving meshes: their fragments are listed after the static ones
-    /// every frame, and the octree is rebuilt from all of them.
+    /// The scene has moving meshes: every frame lists their fragments after the static
+    /// ones and inserts them into the static part of the octree.
     moving: bool,
+    /// What a frame starts from: the static part (the root alone with `--full-update`).
+    statics: StaticPart,
     /// `--full-update`: every mesh is voxelized again every frame too.
     full_update: bool,
     /// The carry table the current frame writes.
@@ -642,6 +671,7 @@ impl SvoGi {
             octree: octree::OctreePasses::new(ctx, layouts)?,
             bricks: bricks::BrickPasses::new(ctx, layouts)?,
             report: None,
+            statics: StaticPart::root(),
             moving: scene.is_animated(),
             full_update,
             carry_parity: 0,
@@ -708,21 +738,31 @@ impl SvoGi {
         bytes
     }
 
-    /// Builds the octree of the meshes at `draw.time_s` and waits for it: the voxel
-    /// fragments, then the octree and its bricks from them. A pool that overflows is
+    /// Builds the octree and waits for it: the voxel fragments of the static meshes
+    /// (of every mesh in a static scene), then the octree and its bricks from them; with
+    /// moving meshes or `--full-update`, one frame's insertion of the moving meshes at
+    /// `draw.time_s` too, so that the pools have room for it. A pool that overflows is
     /// reported (in the log, and in the report), grown, and its phase runs again.
     pub fn build(&mut self, draw: &SceneDraw, set: vk::DescriptorSet) -> Result<&BuildReport> {
         let start = Instant::now();
         let mut regrowths = Vec::new();
         let mut passes = Vec::new();
         let mut fitted = false;
-        for phase in [Phase::Fragments, Phase::Octree] {
-            loop {
-                let (counters, levels, timings) = self.run(phase, draw, set)?;
-                if counters.overflow == 0 {
+        let mut listed = 0;
+        let mut built = None;
+        let phases: &[Phase] = if self.moving() {
+            &[Phase::Fragments, Phase::Octree, Phase::Frame]
+        } else {
+            &[Phase::Fragments, Phase::Octree]
+        };
+        let mut next = 0;
+        while let Some(&phase) = phases.get(next) {
+            let (counters, levels, timings) = self.run(phase, draw, set, listed)?;
+            if counters.overflow == 0 {
+                if phase == Phase::Octree {
                     let capacities = self.pools.capacities;
                     let fit = capacities.fitted(&counters);
-                    if phase == Phase::Octree && !fitted && fit != capacities {
+                    if !fitted && fit != capacities {
                         // Growth overshoots: size the pools to what they hold (with the
                         // margin moving meshes need) and build the octree once more.
                         log::info!("SVO pools fitted to what they hold: {fit:?}");
@@ -732,66 +772,81 @@ impl SvoGi {
                         self.pools.write_set(&self.ctx, set, self.linear);
                         continue;
                     }
+                    self.statics = if self.moving && !self.full_update {
+                        StaticPart::built(&counters, &levels)
+                    } else {
+                        StaticPart::root()
+                    };
+                    built = Some((counters, levels));
+                } else if phase == Phase::Fragments {
+                    listed = counters.fragment_count;
+                    passes.clear();
+                }
+                if phase != Phase::Frame {
                     passes.extend(timings);
-                    if phase == Phase::Octree {
-                        // Nothing carried yet.
-                        let carry = self.pools.carry.raw;
-                        OneShot::new(&self.ctx)?.run("clear svo carry", |cmd| {
-                            unsafe {
-                                self.ctx
-                                    .device
-                                    .cmd_fill_buffer(cmd, carry, 0, vk::WHOLE_SIZE, 0)
-                            };
-                            Ok(())
-                        })?;
-                        self.report = Some(BuildReport {
-                            counters,
-                            levels,
-                            passes,
-                            regrowths,
-                            wall_ms: start.elapsed().as_secs_f64() * 1e3,
-                        });
-                        return Ok(self.report.as_ref().unwrap());
-                    }
-                    break;
                 }
-                let capacities = self.pools.capacities;
-                let grown = capacities.grown(&counters);
-                let message = format!(
-                    "SVO pools too small ({}); growing them and building again",
-                    overflowed(&counters, &capacities).join("; ")
-                );
-                // The first guess is small on purpose: growing is routine.
-                log::info!("{message}");
-                regrowths.push(message);
-                ensure!(
-                    regrowths.len() < 8,
-                    "the SVO build still overflows after {} regrowths",
-                    regrowths.len()
-                );
-                if phase == Phase::Fragments {
-                    self.fragments = Fragments::new(&self.ctx, grown.fragments)
-                        .context("growing the voxel-fragment list")?;
-                    self.fragments.write_set(&self.ctx, set);
-                    self.pools.capacities.fragments = grown.fragments;
-                } else {
-                    self.pools = Pools::new(&self.ctx, grown, self.moving())
-                        .context("growing the SVO pools")?;
-                    self.pools.write_set(&self.ctx, set, self.linear);
-                }
+                next += 1;
+                continue;
+            }
+            let capacities = self.pools.capacities;
+            let grown = capacities.grown(&counters);
+            let message = format!(
+                "SVO pools too small ({}); growing them and building again",
+                overflowed(&counters, &capacities).join("; ")
+            );
+            // The first guess is small on purpose: growing is routine.
+            log::info!("{message}");
+            regrowths.push(message);
+            ensure!(
+                regrowths.len() < 8,
+                "the SVO build still overflows after {} regrowths",
+                regrowths.len()
+            );
+            if counters.overflow & layout::SVO_OVERFLOW_FRAGMENTS != 0 {
+                self.fragments = Fragments::new(&self.ctx, grown.fragments)
+                    .context("growing the voxel-fragment list")?;
+                self.fragments.write_set(&self.ctx, set);
+                self.pools.capacities.fragments = grown.fragments;
+                next = 0;
+            } else {
+                self.pools =
+                    Pools::new(&self.ctx, grown, self.moving()).context("growing the SVO pools")?;
+                self.pools.write_set(&self.ctx, set, self.linear);
+                // The fragments' GPU times stay; the octree's are taken again.
+                passes.retain(|(name, _)| name == "fragments");
+                next = 1;
             }
         }
-        unreachable!("the octree phase returns")
+        let (counters, levels) = built.context("the octree phase did not run")?;
+        // Nothing carried yet.
+        let carry = self.pools.carry.raw;
+        OneShot::new(&self.ctx)?.run("clear svo carry", |cmd| {
+            unsafe {
+                self.ctx
+                    .device
+                    .cmd_fill_buffer(cmd, carry, 0, vk::WHOLE_SIZE, 0)
+            };
+            Ok(())
+        })?;
+        Ok(self.report.insert(BuildReport {
+            counters,
+            levels,
+            passes,
+            regrowths,
+            wall_ms: start.elapsed().as_secs_f64() * 1e3,
+        }))
     }
 
     /// Runs one phase of the build and waits for it; returns the counters, the level
-    /// table's first `depth` rows and the phase's GPU time per pass.
+    /// table's first `depth` rows and the phase's GPU time per pass. `listed`: the
+    /// fragments the fragment phase listed.
     #[allow(clippy::type_complexity)]
     fn run(
         &self,
         phase: Phase,
         draw: &SceneDraw,
         set: vk::DescriptorSet,
+        listed: u32,
     ) -> Result<(SvoCounters, Vec<SvoLevel>, Vec<(String, f64)>)> {
         let mut timer = GpuTimer::new(&self.ctx)?;
         let readback = Buffer::new(
@@ -805,7 +860,11 @@ impl SvoGi {
             timer.reset(cmd);
             match phase {
                 Phase::Fragments => self.record_fragments(cmd, &mut timer, draw, set),
-                Phase::Octree => self.record_octree(cmd, &mut timer, draw.frame_set, set, true),
+                Phase::Octree => {
+                    self.record_start(cmd, &StaticPart::root(), 0, listed);
+                    self.record_levels(cmd, &mut timer, draw.frame_set, set, Over::Level);
+                }
+                Phase::Frame => self.record_frame(cmd, &mut timer, draw, set),
             }
             self.copy_counters(cmd, readback.raw);
             Ok(())
@@ -821,7 +880,8 @@ impl SvoGi {
         Ok((counters, levels, timer.results()?))
     }
 
-    /// Records the first phase: the counters reset, then the voxel fragments.
+    /// Records the first phase: the counters reset, then the voxel fragments of the
+    /// static meshes (of every mesh in a static scene).
     fn record_fragments(
         &self,
         cmd: vk::CommandBuffer,
@@ -836,7 +896,6 @@ impl SvoGi {
             fragment_capacity: self.fragments.capacity,
             ..Default::default()
         };
-        // The whole head (the octree phase resets its part but for the overflow bits).
         update_buffer(
             ctx,
             cmd,
@@ -845,54 +904,41 @@ impl SvoGi {
             bytemuck::bytes_of(&counters),
             vk::PipelineStageFlags2::FRAGMENT_SHADER,
         );
-        timer.begin(cmd, "fragments");
-        let n = self.grid.resolution;
-        if self.moving {
-            self.voxelize.record(ctx, cmd, draw, set, n, Meshes::Static);
-            self.copy_static_count(cmd);
-            self.voxelize.record(ctx, cmd, draw, set, n, Meshes::Moving);
+        let meshes = if self.moving {
+            Meshes::Static
         } else {
-            self.voxelize.record(ctx, cmd, draw, set, n, Meshes::All);
-            self.copy_static_count(cmd);
-        }
+            Meshes::All
+        };
+        self.record_fragment_list(cmd, timer, draw, set, meshes);
+    }
+
+    /// Records the voxelization of `meshes` into the fragment list.
+    fn record_fragment_list(
+        &self,
+        cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
+        draw: &SceneDraw,
+        set: vk::DescriptorSet,
+        meshes: Meshes,
+    ) {
+        let ctx = &self.ctx;
+        timer.begin(cmd, "fragments");
+        self.voxelize
+            .record(ctx, cmd, draw, set, self.grid.resolution, meshes);
         stage_barrier(
             ctx,
             cmd,
-            vk::PipelineStageFlags2::FRAGMENT_SHADER,
-            vk::PipelineStageFlags2::COPY,
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::PipelineStageFlags2::ALL_COMMANDS,
         );
         timer.end(cmd);
     }
 
-    /// Copies the fragments listed so far into `static_fragment_count` (after the static
-    /// meshes' draws).
-    fn copy_static_count(&self, cmd: vk::CommandBuffer) {
-        let ctx = &self.ctx;
-        stage_barrier(
-            ctx,
-            cmd,
-            vk::PipelineStageFlags2::FRAGMENT_SHADER,
-            vk::PipelineStageFlags2::COPY,
-        );
-        let region = vk::BufferCopy {
-            src_offset: std::mem::offset_of!(SvoCounters, fragment_count) as u64,
-            dst_offset: std::mem::offset_of!(SvoCounters, static_fragment_count) as u64,
-            size: 4,
-        };
-        let raw = self.counters.raw;
-        unsafe { ctx.device.cmd_copy_buffer(cmd, raw, raw, &[region]) };
-        stage_barrier(
-            ctx,
-            cmd,
-            vk::PipelineStageFlags2::COPY,
-            vk::PipelineStageFlags2::FRAGMENT_SHADER,
-        );
-    }
-
-    /// With moving meshes, every frame: their fragments listed anew after the static
-    /// ones (kept from the build), and the octree rebuilt from all of them. A pool that
-    /// overflowed in an earlier frame (its counters are read back when its slot comes
-    /// round) is grown first, with the GPU idle, by a full build.
+    /// With moving meshes or `--full-update`, every frame: the static part restored, the
+    /// moving meshes' fragments listed after the static ones (kept from the build), and
+    /// inserted into the octree (Dřínovský 2013, 5.7). A pool that overflowed in an
+    /// earlier frame (its counters are read back when its slot comes round) is grown
+    /// first, with the GPU idle, by a full build.
     pub fn record_moving(
         &mut self,
         cmd: vk::CommandBuffer,
@@ -915,40 +961,14 @@ impl SvoGi {
         }
         self.carry_parity ^= 1;
         let ctx = &self.ctx;
-        let report = self.report.as_ref().context("the octree was not built")?;
-        // With a full update no fragment is kept.
-        let statics = if self.full_update {
-            0
-        } else {
-            report.counters.static_fragment_count
-        };
-        // The fragment fields, the node counts and the overflow bits.
-        let head = [
-            statics.div_ceil(layout::SVO_GROUP_SIZE),
-            1,
-            1,
-            statics,
-            self.fragments.capacity,
-            0,
-            0,
-            0,
-        ];
+        // The carry table this frame writes; the other holds what last frame gathered.
+        let half = 16 * u64::from(self.pools.carry_capacity);
         stage_barrier(
             ctx,
             cmd,
             vk::PipelineStageFlags2::ALL_COMMANDS,
             vk::PipelineStageFlags2::ALL_TRANSFER,
         );
-        update_buffer(
-            ctx,
-            cmd,
-            self.counters.raw,
-            0,
-            bytemuck::cast_slice(&head),
-            vk::PipelineStageFlags2::FRAGMENT_SHADER,
-        );
-        // The carry table this frame writes; the other holds what last frame gathered.
-        let half = 16 * u64::from(self.pools.carry_capacity);
         unsafe {
             ctx.device.cmd_fill_buffer(
                 cmd,
@@ -958,111 +978,125 @@ impl SvoGi {
                 0,
             )
         };
-        timer.begin(cmd, "fragments");
+        self.record_frame(cmd, timer, draw, set);
+        self.copy_counters(cmd, self.frame_counters[slot].raw);
+        Ok(())
+    }
+
+    /// Records one frame's insertion: the static part restored, the moving meshes' (with
+    /// `--full-update`, every mesh's) fragments listed and inserted.
+    fn record_frame(
+        &self,
+        cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
+        draw: &SceneDraw,
+        set: vk::DescriptorSet,
+    ) {
+        let kept = self.statics.fragments;
+        self.record_start(cmd, &self.statics, kept, kept);
         let meshes = if self.full_update {
             Meshes::All
         } else {
             Meshes::Moving
         };
-        self.voxelize
-            .record(ctx, cmd, draw, set, self.grid.resolution, meshes);
-        stage_barrier(
-            ctx,
-            cmd,
-            vk::PipelineStageFlags2::ALL_COMMANDS,
-            vk::PipelineStageFlags2::ALL_COMMANDS,
-        );
-        timer.end(cmd);
-        self.record_octree(cmd, timer, draw.frame_set, set, false);
-        self.copy_counters(cmd, self.frame_counters[slot].raw);
-        Ok(())
+        self.record_fragment_list(cmd, timer, draw, set, meshes);
+        self.record_levels(cmd, timer, draw.frame_set, set, Over::Appended);
     }
 
-    /// Records the second phase, from the fragments: the octree's counters reset, the
-    /// octree, leaf bricks, the list of occupied leaf voxels, and cleared radiance pools.
-    /// `reset_overflow` clears the overflow bits too (a frame keeps those its moving
-    /// meshes' fragments set).
-    fn record_octree(
-        &self,
-        cmd: vk::CommandBuffer,
-        timer: &mut GpuTimer,
-        frame_set: vk::DescriptorSet,
-        set: vk::DescriptorSet,
-        reset_overflow: bool,
-    ) {
+    /// Records the start of an octree: the counters and level table of `part` (the root
+    /// alone for a build), with the fragments from `base` read and `listed` so far; the
+    /// part's nodes restored (the static part from its copy, or the bare root) and the
+    /// sums after its own cleared.
+    fn record_start(&self, cmd: vk::CommandBuffer, part: &StaticPart, base: u32, listed: u32) {
         let ctx = &self.ctx;
         let p = &self.pools;
         let c = &p.capacities;
-        // From `node_count` on: the fragments' counters stay.
         let counters = SvoCounters {
-            // The root.
-            node_count: 1,
+            fragment_groups_x: (listed - base).div_ceil(layout::SVO_GROUP_SIZE),
+            fragment_groups_y: 1,
+            fragment_groups_z: 1,
+            fragment_count: listed,
+            fragment_capacity: self.fragments.capacity,
+            node_count: part.nodes,
             node_capacity: c.nodes,
+            leaf_bricks: part.leaf_bricks,
             leaf_brick_capacity: c.leaf_bricks,
+            interior_bricks: part.interior_bricks,
             interior_brick_capacity: c.interior_bricks,
             leaf_pool_side: p.leaf_side,
             interior_pool_side: p.interior_side,
+            leaf_voxels: part.leaf_voxels,
             leaf_voxel_capacity: c.leaf_voxels,
             carry_capacity: p.carry_capacity,
             carry_parity: self.carry_parity,
+            fragment_base: base,
+            static_node_count: part.nodes,
+            static_leaf_bricks: part.leaf_bricks,
             ..Default::default()
         };
-        let root = SvoLevel {
-            groups_x: 1,
-            groups_y: 1,
-            groups_z: 1,
-            first: 0,
-            count: 1,
-            ..Default::default()
-        };
-        // From `node_count` on, but the overflow bits (the fragments' may be set) and the
-        // static fragments' count.
-        let bytes = bytemuck::bytes_of(&counters);
-        let from = std::mem::offset_of!(SvoCounters, node_count);
-        let overflow = std::mem::offset_of!(SvoCounters, overflow);
-        let after = if reset_overflow {
-            overflow
-        } else {
-            overflow + 4
-        };
-        let statics = std::mem::offset_of!(SvoCounters, static_fragment_count);
-        let mut tail = bytes[statics + 4..].to_vec();
-        tail.extend_from_slice(bytemuck::bytes_of(&root));
+        let mut head = bytemuck::bytes_of(&counters).to_vec();
+        for level in part.level_table() {
+            head.extend_from_slice(bytemuck::bytes_of(&level));
+        }
         stage_barrier(
             ctx,
             cmd,
             vk::PipelineStageFlags2::ALL_COMMANDS,
             vk::PipelineStageFlags2::ALL_TRANSFER,
         );
+        let sums_kept = 4 * u64::from(layout::SVO_SUM_WORDS) * u64::from(part.leaf_voxels);
         unsafe {
-            let raw = self.counters.raw;
-            ctx.device
-                .cmd_update_buffer(cmd, raw, from as u64, &bytes[from..overflow]);
-            // `after` is `overflow` when the bits are reset with what follows.
-            ctx.device
-                .cmd_update_buffer(cmd, raw, after as u64, &bytes[after..statics]);
-            ctx.device
-                .cmd_update_buffer(cmd, raw, statics as u64 + 4, &tail);
-            // The root: no children yet, at (0, 0, 0).
-            ctx.device.cmd_fill_buffer(cmd, p.nodes.raw, 0, 4, 0);
-            ctx.device.cmd_fill_buffer(cmd, p.coords.raw, 0, 4, 0);
-            ctx.device
-                .cmd_fill_buffer(cmd, p.sums.raw, 0, vk::WHOLE_SIZE, 0);
+            let device = &ctx.device;
+            device.cmd_update_buffer(cmd, self.counters.raw, 0, &head);
+            if part.saved {
+                let region = vk::BufferCopy::default().size(4 * u64::from(part.nodes));
+                device.cmd_copy_buffer(cmd, p.static_children.raw, p.nodes.raw, &[region]);
+                device.cmd_copy_buffer(cmd, p.static_bricks.raw, p.bricks.raw, &[region]);
+            } else {
+                // The root: no children yet, no brick, at (0, 0, 0).
+                device.cmd_fill_buffer(cmd, p.nodes.raw, 0, 4, 0);
+                device.cmd_fill_buffer(cmd, p.bricks.raw, 0, 4, layout::SVO_NO_BRICK);
+                device.cmd_fill_buffer(cmd, p.coords.raw, 0, 4, 0);
+            }
+            if sums_kept < p.sums.size {
+                device.cmd_fill_buffer(cmd, p.sums.raw, sums_kept, vk::WHOLE_SIZE, 0);
+            }
         }
         stage_barrier(
             ctx,
             cmd,
             vk::PipelineStageFlags2::ALL_TRANSFER,
-            vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
+            vk::PipelineStageFlags2::FRAGMENT_SHADER
+                | vk::PipelineStageFlags2::COMPUTE_SHADER
+                | vk::PipelineStageFlags2::DRAW_INDIRECT,
         );
+    }
+
+    /// Records the octree's levels from the fragments (`record_start` wrote where they
+    /// start), the neighbour pointers of the nodes in `neighbours`, the new leaf bricks
+    /// and the list of occupied leaf voxels. In a build (`Over::Level`) the brick pools
+    /// are cleared first, and with moving meshes the static part is saved at the end.
+    fn record_levels(
+        &self,
+        cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
+        frame_set: vk::DescriptorSet,
+        set: vk::DescriptorSet,
+        neighbours: Over,
+    ) {
+        let ctx = &self.ctx;
+        let p = &self.pools;
+        let build = neighbours == Over::Level;
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, set)];
         let counters = self.counters.raw;
         self.octree
-            .record(ctx, cmd, timer, &sets, counters, self.depth);
+            .record(ctx, cmd, timer, &sets, counters, self.depth, neighbours);
 
         timer.begin(cmd, "brick fill");
-        for image in &p.leaf_attributes {
-            clear_to_zero(ctx, cmd, image, p.last_use(), BRICK_USE);
+        if build {
+            for image in &p.leaf_attributes {
+                clear_to_zero(ctx, cmd, image, p.last_use(), BRICK_USE);
+            }
         }
         self.bricks.record_fill(cmd, &sets, counters);
         compute_to_compute(ctx, cmd);
@@ -1070,19 +1104,22 @@ impl SvoGi {
 
         timer.begin(cmd, "voxel list");
         reset_voxel_list(ctx, cmd, p.voxel_list.raw);
+        if build {
+            // Voxel shading writes only the listed voxels, whose bricks' other voxels
+            // cones and the filter read: they must be zero (a frame's new bricks are
+            // cleared by the list pass). The direct light is read only at listed voxels,
+            // and the filter and the borders write every texel of the interior bricks in
+            // use: those two need clearing only once, out of their initial layout.
+            clear_to_zero(ctx, cmd, &p.leaf_radiance, p.last_use(), RADIANCE_USE);
+            if !p.cleared.get() {
+                for image in [&p.leaf_direct, &p.directional] {
+                    clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, RADIANCE_USE);
+                }
+            }
+            p.cleared.set(true);
+        }
         self.bricks
             .record_list(cmd, &sets, counters, self.depth - 1);
-        // Voxel shading writes only the listed voxels, whose bricks' other voxels cones and
-        // the filter read: they must be zero. The direct light is read only at listed
-        // voxels, and the filter and the borders write every texel of the interior bricks
-        // in use: those two need clearing only once, out of their initial layout.
-        clear_to_zero(ctx, cmd, &p.leaf_radiance, p.last_use(), RADIANCE_USE);
-        if !p.cleared.get() {
-            for image in [&p.leaf_direct, &p.directional] {
-                clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, RADIANCE_USE);
-            }
-        }
-        p.cleared.set(true);
         stage_barrier(
             ctx,
             cmd,
@@ -1090,6 +1127,27 @@ impl SvoGi {
             vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
         );
         timer.end(cmd);
+        if build && self.moving && !self.full_update {
+            stage_barrier(
+                ctx,
+                cmd,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::PipelineStageFlags2::COPY,
+            );
+            let region = vk::BufferCopy::default().size(p.nodes.size);
+            unsafe {
+                ctx.device
+                    .cmd_copy_buffer(cmd, p.nodes.raw, p.static_children.raw, &[region]);
+                ctx.device
+                    .cmd_copy_buffer(cmd, p.bricks.raw, p.static_bricks.raw, &[region]);
+            }
+            stage_barrier(
+                ctx,
+                cmd,
+                vk::PipelineStageFlags2::COPY,
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+            );
+        }
     }
 
     /// Copies the counters and the level table to `to` (host-visible) at the end of the
@@ -1111,13 +1169,90 @@ impl SvoGi {
     }
 }
 
-/// The two phases of a build, each run again alone when its pools overflow.
+/// The static part of the octree (Dřínovský 2013, 5.7): built once; every frame with
+/// moving meshes starts from it and appends their nodes after it.
+#[derive(Clone, Debug)]
+struct StaticPart {
+    /// Fragments of the static meshes, first in the list (a frame lists more after them).
+    fragments: u32,
+    nodes: u32,
+    leaf_bricks: u32,
+    interior_bricks: u32,
+    leaf_voxels: u32,
+    /// Per level, its first node and node count.
+    levels: Vec<(u32, u32)>,
+    /// Its nodes' child entries and bricks are saved in `Pools::static_children` and
+    /// `static_bricks` (otherwise it is the bare root).
+    saved: bool,
+}
+
+impl StaticPart {
+    /// Nothing static: the bare root, from which a build starts (and every frame, with
+    /// `--full-update`).
+    fn root() -> Self {
+        Self {
+            fragments: 0,
+            nodes: 1,
+            leaf_bricks: 0,
+            interior_bricks: 0,
+            leaf_voxels: 0,
+            levels: vec![(0, 1)],
+            saved: false,
+        }
+    }
+
+    /// What a build of the static meshes made (every level but the root appended).
+    fn built(counters: &SvoCounters, levels: &[SvoLevel]) -> Self {
+        let mut runs = vec![(0, 1)];
+        runs.extend(
+            levels
+                .iter()
+                .skip(1)
+                .map(|l| (l.appended_first, l.appended_count)),
+        );
+        Self {
+            fragments: counters.fragment_count,
+            nodes: counters.node_count,
+            leaf_bricks: counters.leaf_bricks,
+            interior_bricks: counters.interior_bricks,
+            leaf_voxels: counters.leaf_voxels,
+            levels: runs,
+            saved: true,
+        }
+    }
+
+    /// The level table a build or frame starts from: each level's static run, nothing
+    /// appended yet (the root's appended run starts after the static nodes).
+    fn level_table(&self) -> Vec<SvoLevel> {
+        (0..layout::SVO_MAX_LEVELS as usize)
+            .map(|l| {
+                let (first, count) = self.levels.get(l).copied().unwrap_or((0, 0));
+                SvoLevel {
+                    groups_x: count.div_ceil(layout::SVO_GROUP_SIZE),
+                    groups_y: 1,
+                    groups_z: 1,
+                    first,
+                    count,
+                    appended_first: if l == 0 { self.nodes } else { 0 },
+                    appended_groups_y: 1,
+                    appended_groups_z: 1,
+                    ..Default::default()
+                }
+            })
+            .collect()
+    }
+}
+
+/// The phases of a build, each run again alone when its pools overflow (from the
+/// fragments when the fragment list overflowed, from the octree otherwise).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Phase {
     /// The voxel-fragment list.
     Fragments,
     /// The octree, its bricks and the occupied-voxel list, from the fragments.
     Octree,
+    /// One frame's insertion of the moving meshes, to size the pools for it.
+    Frame,
 }
 
 /// How the leaf-brick attribute images are used between passes.

@@ -2,7 +2,9 @@
 //! per level, flag the nodes the voxel fragments reach (`glsl/svo/octree/flag.comp`),
 //! allocate bricks and child tiles for the flagged ones (`alloc.comp`), enter the new
 //! level into the level table (`level.comp`) and initialise its nodes (`init.comp`);
-//! then link every node to its six neighbours (`neighbours.comp`).
+//! then link every node to its six neighbours (`neighbours.comp`). A frame with moving
+//! meshes runs the same passes over their fragments only, on top of the static part
+//! (Dřínovský 2013, 5.7): new nodes are appended to each level's static run.
 
 use std::sync::Arc;
 
@@ -19,20 +21,38 @@ pub fn level_offset(level: u32) -> vk::DeviceSize {
         as vk::DeviceSize
 }
 
-/// Pushes `level` to `pipeline`, binds it with `sets` and dispatches the workgroup counts
-/// at byte `offset` of `counters` (0: one invocation per fragment; [`level_offset`]: one
-/// per node of a level).
+/// What a pass over the octree runs over: one invocation per item.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Over {
+    /// The voxel fragments the octree passes read (from `SvoCounters::fragment_base`).
+    Fragments,
+    /// Every node of the level: its static run, then its appended one.
+    Level,
+    /// The level's appended nodes only (new this build or frame).
+    Appended,
+}
+
+/// Pushes `level` to `pipeline`, binds it with `sets` and dispatches it indirectly over
+/// `over`, whose workgroup counts `counters` holds.
 pub fn dispatch_for_level(
     pipeline: &Pipeline,
     cmd: vk::CommandBuffer,
     sets: &[(u32, vk::DescriptorSet)],
     level: u32,
     counters: vk::Buffer,
-    offset: vk::DeviceSize,
+    over: Over,
 ) {
     let push = SvoPush {
         level,
+        appended_only: u32::from(over == Over::Appended),
         ..Default::default()
+    };
+    let offset = match over {
+        Over::Fragments => 0,
+        Over::Level => level_offset(level),
+        Over::Appended => {
+            level_offset(level) + std::mem::offset_of!(SvoLevel, appended_groups_x) as u64
+        }
     };
     pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
     pipeline.dispatch_indirect(cmd, sets, counters, offset);
@@ -80,9 +100,13 @@ impl OctreePasses {
         })
     }
 
-    /// Builds levels 1 to `depth - 1` under the root (whose entries and level-table row
-    /// the caller wrote) from the voxel fragments, then the neighbour pointers. `counters`
+    /// Builds levels 1 to `depth - 1` under the root (whose entries and level-table rows
+    /// the caller wrote: the root alone for a build, the static part for a frame) from
+    /// the voxel fragments, then the neighbour pointers of the nodes in `neighbours`
+    /// (every node in a build; the appended ones in a frame, as the static nodes' links
+    /// to each other hold, and a missing link is searched from the root). `counters`
     /// holds the indirect dispatches.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         ctx: &Context,
@@ -91,15 +115,16 @@ impl OctreePasses {
         sets: &[(u32, vk::DescriptorSet)],
         counters: vk::Buffer,
         depth: u32,
+        neighbours: Over,
     ) {
         for level in 0..depth {
             timer.begin(cmd, &format!("flag {level}"));
-            dispatch_for_level(&self.flag, cmd, sets, level, counters, 0);
+            dispatch_for_level(&self.flag, cmd, sets, level, counters, Over::Fragments);
             compute_to_compute(ctx, cmd);
             timer.end(cmd);
 
             timer.begin(cmd, &format!("alloc {level}"));
-            dispatch_for_level(&self.alloc, cmd, sets, level, counters, level_offset(level));
+            dispatch_for_level(&self.alloc, cmd, sets, level, counters, Over::Level);
             compute_to_compute(ctx, cmd);
             timer.end(cmd);
 
@@ -113,15 +138,14 @@ impl OctreePasses {
                 self.level.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
                 self.level.dispatch(cmd, sets, [1, 1, 1]);
                 compute_to_indirect(ctx, cmd);
-                dispatch_for_level(&self.init, cmd, sets, child, counters, level_offset(child));
+                dispatch_for_level(&self.init, cmd, sets, child, counters, Over::Appended);
                 compute_to_compute(ctx, cmd);
                 timer.end(cmd);
             }
         }
         timer.begin(cmd, "neighbours");
         for level in 0..depth {
-            let offset = level_offset(level);
-            dispatch_for_level(&self.neighbours, cmd, sets, level, counters, offset);
+            dispatch_for_level(&self.neighbours, cmd, sets, level, counters, neighbours);
         }
         compute_to_compute(ctx, cmd);
         timer.end(cmd);

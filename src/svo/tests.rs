@@ -39,8 +39,12 @@ struct Fragment {
 /// The octree as downloaded.
 struct Downloaded {
     fragments: Vec<Fragment>,
-    /// Per level: (first node, count).
-    levels: Vec<(u32, u32)>,
+    /// Per level: its static run and its appended run, (first node, count) each.
+    runs: Vec<[(u32, u32); 2]>,
+    /// Per level: its nodes, the static run's then the appended run's.
+    levels: Vec<Vec<u32>>,
+    /// Nodes of the static part (1, the root, after a build).
+    static_nodes: u32,
     children: Vec<u32>,
     coords: Vec<[u32; 3]>,
     bricks: Vec<u32>,
@@ -79,7 +83,19 @@ fn download(svo: &SvoGi) -> Downloaded {
                 emission: shading[2 * i + 1],
             })
             .collect(),
-        levels: levels.iter().map(|l| (l.first, l.count)).collect(),
+        runs: levels
+            .iter()
+            .map(|l| [(l.first, l.count), (l.appended_first, l.appended_count)])
+            .collect(),
+        levels: levels
+            .iter()
+            .map(|l| {
+                (l.first..l.first + l.count)
+                    .chain(l.appended_first..l.appended_first + l.appended_count)
+                    .collect()
+            })
+            .collect(),
+        static_nodes: counters.static_node_count,
         children: svo.download_words(&p.nodes).unwrap(),
         coords: svo
             .download_words(&p.coords)
@@ -106,33 +122,34 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
     let depth = svo.depth;
     let voxels: HashSet<[u32; 3]> = d.fragments.iter().map(|f| unpack(f.position)).collect();
     let cpu = cpu_octree(&voxels, depth);
-    // Level l + 1 holds a tile of 8 children under every occupied node of level l.
-    for (l, &(first, count)) in d.levels.iter().enumerate() {
+    // Level l + 1 holds a tile of 8 children under every occupied node of level l; each
+    // level's appended run follows the level above's (the root's starts after the static
+    // part).
+    for (l, nodes) in d.levels.iter().enumerate() {
         let expected = if l == 0 { 1 } else { 8 * cpu[l - 1].len() };
-        assert_eq!(count as usize, expected, "level {l}: node count");
-        let previous_end = if l == 0 {
-            0
-        } else {
-            d.levels[l - 1].0 + d.levels[l - 1].1
-        };
-        assert_eq!(
-            first,
-            previous_end,
-            "level {l} follows level {}",
-            l.max(1) - 1
-        );
+        assert_eq!(nodes.len(), expected, "level {l}: node count");
+        if l > 0 {
+            let above = d.runs[l - 1][1];
+            assert_eq!(
+                d.runs[l][1].0,
+                above.0 + above.1,
+                "level {l} follows level {}",
+                l - 1
+            );
+        }
     }
-    let total: u32 = d.levels.iter().map(|l| l.1).sum();
+    let total: usize = d.levels.iter().map(Vec::len).sum();
     let counters = live_counters(svo).0;
-    assert_eq!(total, counters.node_count);
+    assert_eq!(total as u32, counters.node_count);
+    let built = d.static_nodes <= 1;
 
     let mut by_coords: Vec<HashMap<[u32; 3], u32>> = Vec::new();
     let mut leaf_bricks = HashSet::new();
     let mut leaf_sums = Vec::new();
     let mut interior_bricks = HashSet::new();
-    for (l, &(first, count)) in d.levels.iter().enumerate() {
+    for (l, nodes) in d.levels.iter().enumerate() {
         let mut map = HashMap::new();
-        for node in first..first + count {
+        for &node in nodes {
             let c = d.coords[node as usize];
             assert!(
                 map.insert(c, node).is_none(),
@@ -168,13 +185,16 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
                     leaf_sums.push((tile >> 8, mask.count_ones()));
                 }
             } else if occupied {
-                let (next_first, next_count) = d.levels[l + 1];
-                assert!(
-                    tile >= next_first && tile + 8 <= next_first + next_count,
-                    "level {l} node {node}: children {tile} outside level {}",
-                    l + 1
-                );
-                assert_eq!((tile - next_first) % 8, 0, "tiles of 8");
+                let run = d.runs[l + 1]
+                    .into_iter()
+                    .find(|&(first, count)| tile >= first && tile + 8 <= first + count);
+                let Some((first, _)) = run else {
+                    panic!(
+                        "level {l} node {node}: children {tile} outside level {}",
+                        l + 1
+                    );
+                };
+                assert_eq!((tile - first) % 8, 0, "tiles of 8");
                 for o in 0..8u32 {
                     let expected = [
                         2 * c[0] + (o & 1),
@@ -189,17 +209,28 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
         }
         by_coords.push(map);
     }
-    assert_eq!(leaf_bricks.len() as u32, counters.leaf_bricks);
-    // The leaves' sums tile the sums buffer without gaps or overlaps.
+    // After a frame, the static bricks and sums of the static leaves that moving meshes
+    // reached lie unused: they are restored next frame.
+    assert!(leaf_bricks.iter().all(|&b| b < counters.leaf_bricks));
+    assert!(interior_bricks
+        .iter()
+        .all(|&b| b < counters.interior_bricks));
+    // The leaves' sums tile the sums buffer without overlaps (nor gaps, after a build).
     leaf_sums.sort_unstable();
     let mut next = 0;
     for (first, count) in &leaf_sums {
-        assert_eq!(*first, next, "leaf sums overlap or leave a gap");
-        next += count;
+        if built {
+            assert_eq!(*first, next, "leaf sums leave a gap");
+        }
+        assert!(*first >= next, "leaf sums overlap");
+        next = first + count;
     }
-    assert_eq!(next as usize, voxels.len());
-    assert_eq!(counters.leaf_voxels as usize, voxels.len());
-    assert_eq!(interior_bricks.len() as u32, counters.interior_bricks);
+    assert!(next <= counters.leaf_voxels);
+    if built {
+        assert_eq!(leaf_bricks.len() as u32, counters.leaf_bricks);
+        assert_eq!(counters.leaf_voxels as usize, voxels.len());
+        assert_eq!(interior_bricks.len() as u32, counters.interior_bricks);
+    }
 
     // Neighbours: the node at the next coordinates of the same level, and symmetric.
     let mut links = 0;
@@ -213,13 +244,23 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
                     .ok()
                     .and_then(|_| map.get(&n.map(|x| x as u32)).copied())
                     .unwrap_or(layout::SVO_NO_NODE);
+                // A static node keeps its static links; one to an appended node is
+                // missing (the passes that follow links search the octree there).
+                let unlinked = |from: u32, to: u32| from < d.static_nodes && to >= d.static_nodes;
                 let got = d.neighbours[6 * node as usize + dir];
-                assert_eq!(got, expected, "level {l} node {node} neighbour {dir}");
-                if got != layout::SVO_NO_NODE {
-                    let back = d.neighbours[6 * got as usize + (dir ^ 1)];
-                    assert_eq!(back, node, "neighbour links are symmetric");
-                    links += 1;
+                if got != expected || expected == layout::SVO_NO_NODE {
+                    assert!(
+                        got == expected || (got == layout::SVO_NO_NODE && unlinked(node, expected)),
+                        "level {l} node {node} neighbour {dir}: {got} instead of {expected}"
+                    );
+                    continue;
                 }
+                let back = d.neighbours[6 * got as usize + (dir ^ 1)];
+                assert!(
+                    back == node || (back == layout::SVO_NO_NODE && unlinked(got, node)),
+                    "neighbour links are symmetric"
+                );
+                links += 1;
             }
         }
     }
@@ -227,7 +268,7 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
         "depth {depth}: {} fragments, {} voxels, nodes per level {:?}, {} neighbour links",
         d.fragments.len(),
         voxels.len(),
-        d.levels.iter().map(|l| l.1).collect::<Vec<_>>(),
+        d.levels.iter().map(Vec::len).collect::<Vec<_>>(),
         links
     );
     voxels
@@ -321,9 +362,9 @@ fn leaf_bricks_average_their_fragments() {
     let svo = renderer.gi().unwrap().octree().unwrap();
     let d = download(svo);
     let depth = svo.depth;
-    let (leaf_first, leaf_count) = d.levels[depth as usize - 1];
-    let leaf_of: HashMap<[u32; 3], u32> = (leaf_first..leaf_first + leaf_count)
-        .map(|n| (d.coords[n as usize], n))
+    let leaf_of: HashMap<[u32; 3], u32> = d.levels[depth as usize - 1]
+        .iter()
+        .map(|&n| (d.coords[n as usize], n))
         .collect();
     let side = svo.pools.leaf_side;
     let edge = side * layout::SVO_ATTRIBUTE_BRICK;
@@ -467,8 +508,9 @@ fn brick_voxels(
     d: &Downloaded,
     level: usize,
 ) -> impl Iterator<Item = (u32, u32, [u32; 3], [u32; 3])> + '_ {
-    let (first, count) = d.levels[level];
-    (first..first + count)
+    d.levels[level]
+        .iter()
+        .copied()
         .filter(|&node| d.bricks[node as usize] != layout::SVO_NO_BRICK)
         .flat_map(move |node| {
             (0..8u32).map(move |o| {
@@ -588,10 +630,9 @@ fn bricks_filter_and_borders_match_cpu() {
     for level in 0..depth as usize {
         let is_leaf = level + 1 == depth as usize;
         let n = 2i32 << level;
-        let (first, count) = d.levels[level];
         for dir in 0..if is_leaf { 1 } else { 6 } {
             let grid = dense(level, dir, false);
-            for node in first..first + count {
+            for &node in &d.levels[level] {
                 let brick = d.bricks[node as usize];
                 if brick == layout::SVO_NO_BRICK {
                     continue;
@@ -644,13 +685,16 @@ fn leaf_snapshot(r: &Renderer) -> (Vec<u32>, Vec<([u32; 3], u32)>) {
         }
     }
     voxels.sort_unstable();
-    let nodes: Vec<u32> = d.levels.iter().map(|l| l.1).collect();
+    let nodes: Vec<u32> = d.levels.iter().map(|l| l.len() as u32).collect();
     (nodes, voxels)
 }
 
 /// A mesh moving across the box leaves no nodes or voxels behind: after frames at three
 /// times, the octree (nodes per level, leaf voxels and their albedo) equals a fresh build
-/// at the last time, and differs from the first time's.
+/// at the last time and a full rebuild (`--full-update`), and differs from the first
+/// time's. Its structure matches a CPU octree of the static and moving fragments, and
+/// the static part is as its build left it: the same runs of nodes per level, and every
+/// static node's entry restored but where the moving cube reached it.
 #[test]
 fn moving_mesh_leaves_no_nodes_behind() {
     let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
@@ -658,33 +702,84 @@ fn moving_mesh_leaves_no_nodes_behind() {
     };
     let dir = std::env::temp_dir().join(format!("voxcone-svo-moving-{}", std::process::id()));
     let scene = moving_cube_scene(&cornell, &dir);
-    let settings = gi_settings(64, VoxelStructure::Octree { capacities: None }, false);
+    let structure = VoxelStructure::Octree { capacities: None };
+    let settings = gi_settings(64, structure, false);
     let (ctx, moved) = render_frames(scene.clone(), settings.clone(), &[0.0, 0.5, 1.0]);
     let (_, fresh) = render_frames(scene.clone(), settings.clone(), &[1.0]);
+    let (_, full) = render_frames(scene.clone(), gi_settings(64, structure, true), &[1.0]);
     let (_, start) = render_frames(scene, settings, &[0.0]);
-    let (moved, fresh, start) = (
+
+    let svo = moved.gi().unwrap().octree().unwrap();
+    let d = download(svo);
+    check_structure(svo, &d);
+    let statics = &svo.statics;
+    let report = svo.report().unwrap();
+    assert!(statics.saved);
+    assert_eq!(statics.nodes, report.counters.node_count);
+    assert_eq!(d.static_nodes, statics.nodes);
+    for (l, runs) in d.runs.iter().enumerate() {
+        assert_eq!(runs[0], statics.levels[l], "level {l}: static run");
+    }
+    let kept = svo.download_words(&svo.pools.static_children).unwrap();
+    let leaf_level = svo.depth as usize - 1;
+    let mut reached = [0; 2];
+    for (l, nodes) in d.levels.iter().enumerate() {
+        for &node in nodes.iter().filter(|&&n| n < statics.nodes) {
+            let (now, was) = (d.children[node as usize], kept[node as usize]);
+            if now == was {
+                continue;
+            }
+            if l == leaf_level {
+                // Copied on write: its static voxels and more, new sums and brick.
+                assert_eq!(
+                    now & was & 0xff,
+                    was & 0xff,
+                    "leaf {node} lost static voxels"
+                );
+                assert!(d.bricks[node as usize] >= statics.leaf_bricks);
+                assert!(now >> 8 >= statics.leaf_voxels);
+                reached[0] += 1;
+            } else {
+                // Empty in the static part; children appended now.
+                assert_eq!(was, 0, "level {l} node {node}: static children replaced");
+                assert!(now >= statics.nodes);
+                reached[1] += 1;
+            }
+        }
+    }
+    eprintln!(
+        "static part: {} nodes, runs {:?}; reached by the cube: {} static leaves, {} empty \
+         static nodes",
+        statics.nodes, statics.levels, reached[0], reached[1]
+    );
+    assert!(reached[0] > 0, "the cube reached no static leaf");
+
+    let (moved, fresh, full, start) = (
         leaf_snapshot(&moved),
         leaf_snapshot(&fresh),
+        leaf_snapshot(&full),
         leaf_snapshot(&start),
     );
     eprintln!(
-        "nodes per level: moved {:?}, fresh {:?}, start {:?}; leaf voxels {} / {} / {}",
+        "nodes per level: moved {:?}, fresh {:?}, full {:?}, start {:?}; leaf voxels {} / {} / \
+         {} / {}",
         moved.0,
         fresh.0,
+        full.0,
         start.0,
         moved.1.len(),
         fresh.1.len(),
+        full.1.len(),
         start.1.len()
     );
     assert_ne!(start.1, fresh.1, "the cube did not move");
-    assert_eq!(
-        moved.0, fresh.0,
-        "nodes per level differ from a fresh build"
-    );
-    assert!(
-        moved.1 == fresh.1,
-        "leaf voxels or albedo differ from a fresh build"
-    );
+    for (name, other) in [("a fresh build", &fresh), ("a full rebuild", &full)] {
+        assert_eq!(moved.0, other.0, "nodes per level differ from {name}");
+        assert!(
+            moved.1 == other.1,
+            "leaf voxels or albedo differ from {name}"
+        );
+    }
     assert_eq!(ctx.validation_messages(), 0);
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -4,7 +4,10 @@
 // the dense grid stores them; zero for a voxel without fragments), and the occupied
 // voxels are listed with their leaf's brick, so that voxel shading and bounces run one
 // invocation per voxel, dispatched indirectly from the list's head as in the dense grid
-// (gi/compact/compact.comp).
+// (gi/compact/compact.comp). Bricks of the static part (before
+// `counters.static_leaf_bricks`) keep the attributes their build wrote; later ones, given
+// this frame, are written, and their empty voxels' radiance cleared (the brick may have
+// held another leaf last frame; voxel shading writes only the listed voxels).
 #define VOXELS_SVO
 #define VOXEL_LIST_WRITER
 #include "svo/octree/level.glsl"
@@ -13,6 +16,7 @@
 layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform writeonly uimage3D leaf_albedo;
 layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform writeonly uimage3D leaf_normal;
 layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform writeonly uimage3D leaf_emission;
+layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D leaf_radiance;
 
 void main() {
     uint node;
@@ -21,6 +25,8 @@ void main() {
     }
     uint brick = node_bricks[node];
     ivec3 origin = brick_origin(brick, counters.leaf_pool_side, SVO_ATTRIBUTE_BRICK);
+    ivec3 radiance_origin = brick_origin(brick, counters.leaf_pool_side, SVO_RADIANCE_BRICK) + 1;
+    bool fresh = brick >= counters.static_leaf_bricks;
     ivec3 first = ivec3(unpack_coord(node_coords[node])) * 2;
     for (int i = 0; i < 8; i++) {
         ivec3 k = ivec3(i & 1, (i >> 1) & 1, i >> 2);
@@ -34,10 +40,15 @@ void main() {
             mean[a] = vec3(sum) / float(max(count, 1u));
         }
         float weight = float(min(count, 255u));
-        imageStore(leaf_albedo, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[0], weight))));
-        imageStore(leaf_normal, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[1], weight))));
-        imageStore(leaf_emission, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[2], weight))));
+        if (fresh) {
+            imageStore(leaf_albedo, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[0], weight))));
+            imageStore(leaf_normal, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[1], weight))));
+            imageStore(leaf_emission, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[2], weight))));
+        }
         if (count == 0u) {
+            if (fresh) {
+                imageStore(leaf_radiance, radiance_origin + k, vec4(0.0));
+            }
             continue;
         }
         uint index = atomicAdd(list.count, 1u);

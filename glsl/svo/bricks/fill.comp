@@ -4,13 +4,15 @@
 // commutative, so the averages that compact.comp takes do not depend on the order in
 // which the fragments were listed (a running average would, and the list's order
 // changes from build to build). A leaf brick holds the leaf's 2x2x2 voxels of the
-// effective grid, voxel (v & 1) of the brick.
+// effective grid, voxel (v & 1) of the brick. Fragments from `counters.fragment_base` on:
+// a frame adds only the moving meshes' (a static leaf they reach has new sums that start
+// from its static ones).
 #include "svo/octree.glsl"
 
 layout(local_size_x = SVO_GROUP_SIZE) in;
 
 void main() {
-    uint index = gl_GlobalInvocationID.x;
+    uint index = counters.fragment_base + gl_GlobalInvocationID.x;
     if (index >= min(counters.fragment_count, counters.fragment_capacity)) {
         return;
     }

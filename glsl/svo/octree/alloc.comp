@@ -1,9 +1,12 @@
 #version 460
 // Each flagged node of `push.level` takes a brick and, above the leaf level, a tile of 8
 // children from the node pool through atomic counters (Crassin & Green 2012); a leaf
-// takes the sums of its occupied voxels instead. The new
-// children are all appended in this pass, so each level's nodes are contiguous. A pool
-// that runs out is reported in `counters.overflow`; the host grows it and builds again.
+// takes the sums of its occupied voxels instead. The new children are all appended in
+// this pass, so each level's appended nodes are contiguous. A static leaf that a frame's
+// moving meshes reach is copied on write (Dřínovský 2013, 5.7, keeps the static part
+// intact): a new brick and new sums, which start from its static voxels' sums, so the
+// static brick and sums stay as built and the next frame finds them again. A pool that
+// runs out is reported in `counters.overflow`; the host grows it and builds again.
 #include "svo/octree/level.glsl"
 
 void main() {
@@ -11,8 +14,8 @@ void main() {
     if (!level_node(node)) {
         return;
     }
-    if ((node_children[node] & SVO_SUBDIVIDE) == 0u) {
-        node_bricks[node] = SVO_NO_BRICK;
+    uint entry = node_children[node];
+    if ((entry & SVO_SUBDIVIDE) == 0u) {
         return;
     }
     bool leaf = push.level + 1u == svo_depth();
@@ -32,15 +35,29 @@ void main() {
     }
     node_bricks[node] = brick;
     if (leaf) {
-        uint mask = node_children[node] & 0xffu;
+        uint mask = entry & 0xffu;
         uint voxels = uint(bitCount(mask));
         uint first = atomicAdd(counters.leaf_voxels, voxels);
         if (first + voxels > counters.leaf_voxel_capacity) {
             atomicOr(counters.overflow, SVO_OVERFLOW_LEAF_VOXELS);
             // No voxels: fill.comp skips the leaf (the build runs again).
             node_children[node] = 0u;
-        } else {
-            node_children[node] = (first << 8) | mask;
+            return;
+        }
+        uint fresh = (first << 8) | mask;
+        node_children[node] = fresh;
+        if (node < counters.static_node_count) {
+            uint kept = static_children[node];
+            for (uint o = 0u; o < 8u; o++) {
+                if ((kept & (1u << o)) == 0u) {
+                    continue;
+                }
+                uint from = leaf_sum_base(kept, o);
+                uint to = leaf_sum_base(fresh, o);
+                for (uint w = 0u; w < SVO_SUM_WORDS; w++) {
+                    leaf_sums[to + w] = leaf_sums[from + w];
+                }
+            }
         }
         return;
     }

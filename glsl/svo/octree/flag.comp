@@ -1,7 +1,8 @@
 #version 460
-// Each voxel fragment descends the octree built so far to its node at `push.level` and
-// flags it for subdivision; at the leaf level, it flags the leaf as holding voxels and
-// marks its own voxel in the leaf's mask.
+// Each voxel fragment from `counters.fragment_base` on descends the octree built so far
+// to its node at `push.level` and flags it for subdivision, unless it has children
+// already (a static node, when a frame inserts the moving meshes' fragments); at the leaf
+// level, it flags the leaf as holding voxels and marks its own voxel in the leaf's mask.
 #include "svo/octree.glsl"
 
 layout(local_size_x = SVO_GROUP_SIZE) in;
@@ -10,7 +11,7 @@ layout(push_constant) uniform PushBlock {
 };
 
 void main() {
-    uint index = gl_GlobalInvocationID.x;
+    uint index = counters.fragment_base + gl_GlobalInvocationID.x;
     if (index >= min(counters.fragment_count, counters.fragment_capacity)) {
         return;
     }
@@ -21,8 +22,12 @@ void main() {
     if (node == SVO_NO_NODE) {
         return;
     }
+    bool leaf = push.level + 1u == svo_depth();
+    if (!leaf && (node_children[node] & SVO_CHILD_MASK) != 0u) {
+        return;
+    }
     uint bits = SVO_SUBDIVIDE;
-    if (push.level + 1u == svo_depth()) {
+    if (leaf) {
         bits |= 1u << leaf_octant(v);
     }
     if ((node_children[node] & bits) != bits) {

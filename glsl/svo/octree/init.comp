@@ -1,6 +1,6 @@
 #version 460
-// Initialises the nodes of a new level: no children, not flagged (the pool is not
-// cleared between builds; `alloc.comp` already wrote their coordinates).
+// Initialises the nodes just appended to a level: no children, not flagged, no brick (the
+// pool is not cleared between builds; `alloc.comp` already wrote their coordinates).
 #include "svo/octree/level.glsl"
 
 void main() {
@@ -9,4 +9,5 @@ void main() {
         return;
     }
     node_children[node] = 0u;
+    node_bricks[node] = SVO_NO_BRICK;
 }

@@ -1,6 +1,7 @@
 #version 460
-// One invocation: enters level `push.level`, which the last allocation appended after
-// level `push.level - 1`, into the level table (first node, count, indirect dispatch).
+// One invocation: enters the nodes that the allocation over level `push.level - 1`
+// appended into the level table as level `push.level`'s appended run (first node,
+// count, indirect dispatches). The level's static run, if any, stays as the host wrote it.
 #include "svo/octree.glsl"
 
 layout(local_size_x = 1) in;
@@ -8,10 +9,19 @@ layout(push_constant) uniform PushBlock {
     SvoPush push;
 };
 
+uint groups(uint nodes) {
+    return (nodes + SVO_GROUP_SIZE - 1u) / SVO_GROUP_SIZE;
+}
+
 void main() {
     SvoLevel above = levels[push.level - 1u];
-    uint first = above.first + above.count;
+    uint first = above.appended_first + above.appended_count;
     uint end = min(counters.node_count, counters.node_capacity);
     uint count = end > first ? end - first : 0u;
-    levels[push.level] = SvoLevel((count + SVO_GROUP_SIZE - 1u) / SVO_GROUP_SIZE, 1u, 1u, first, count, 0u, 0u, 0u);
+    SvoLevel level = levels[push.level];
+    level.appended_first = first;
+    level.appended_count = count;
+    level.groups_x = groups(level.count + count);
+    level.appended_groups_x = groups(count);
+    levels[push.level] = level;
 }
