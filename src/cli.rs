@@ -207,6 +207,10 @@ pub struct BenchArgs {
     /// Also write the results as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Move the first light every frame, as the viewer's arrow keys do: round a circle a
+    /// tenth of the scene's size across, once every 60 frames.
+    #[arg(long)]
+    pub move_light: bool,
 }
 
 #[derive(Args, Debug)]

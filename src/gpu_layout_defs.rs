@@ -124,6 +124,22 @@ gpu_layout! {
         BINDING_SVO_CARRY = 29;
         /// SVO passes (set 2): the static part's child entries as the static build left them (Dřínovský 2013, 5.7): each frame restores them, and a static leaf that a moving mesh's fragments reach reads its own voxels' mask and sums from here, `uint[]` storage buffer.
         BINDING_SVO_STATIC_NODES = 30;
+        /// SVO passes (set 2): per brick (the leaf bricks', then the interior bricks'), `SVO_CHANGED` and `SVO_BORDER` bits while the filter's update lists are built, `uint[]` storage buffer.
+        BINDING_SVO_CHANGES = 31;
+        /// SVO passes (set 2): the filter's update lists (Dřínovský 2013, 5.5): `SvoUpdateList[SVO_UPDATE_LISTS]`, then each list's nodes (`SvoCounters.update_capacity` each), `uint[]` storage buffer.
+        BINDING_SVO_UPDATES = 32;
+        /// Update lists: nodes whose radiance changed, at levels of even and odd parity (0, 1), and nodes whose border must be copied again (2, 3).
+        SVO_UPDATE_LISTS = 4;
+        /// Bit of a brick's change word: its voxels' radiance changed (it is in a changed list).
+        SVO_CHANGED = 1;
+        /// Bit of a brick's change word: a voxel of it or of a neighbour changed (it is in a border list).
+        SVO_BORDER = 2;
+        /// `SvoPush.over`: every node of the level.
+        SVO_OVER_LEVEL = 0;
+        /// `SvoPush.over`: the level's appended nodes only.
+        SVO_OVER_APPENDED = 1;
+        /// `SvoPush.over`: the nodes of update list `SvoPush.list`.
+        SVO_OVER_LIST = 2;
         /// Edge of a leaf attribute brick (albedo, normal, emission, direct light): the leaf's 2x2x2 voxels.
         SVO_ATTRIBUTE_BRICK = 2;
         /// Edge of a radiance brick: the node's 2x2x2 voxels and a border of one voxel copied from the neighbours, so that trilinear filtering inside the node needs no other brick.
@@ -364,8 +380,8 @@ gpu_layout! {
         uint static_node_count,
         /// Leaf bricks of the static part: their attributes are kept; later bricks are filled every frame.
         uint static_leaf_bricks,
-        /// Unused.
-        uint pad2,
+        /// Nodes each update list holds.
+        uint update_capacity,
         /// Unused.
         uint pad3,
         /// Unused.
@@ -400,14 +416,38 @@ gpu_layout! {
         uint pad1,
     }
 
+    /// One update list's head: its nodes follow in `BINDING_SVO_UPDATES`.
+    struct SvoUpdateList {
+        /// Indirect dispatch over the list: workgroups of `SVO_GROUP_SIZE`.
+        uint groups_x,
+        /// Indirect dispatch: 1.
+        uint groups_y,
+        /// Indirect dispatch: 1.
+        uint groups_z,
+        /// Nodes in the list.
+        uint count,
+    }
+
+    /// Push constants of voxel shading.
+    struct InjectPush {
+        /// 1: store the radiance (0: a bounce rewrites it before the next filter).
+        uint store_radiance,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+        /// Unused.
+        uint pad2,
+    }
+
     /// Push constants of the octree passes that work on one level.
     struct SvoPush {
         /// The level.
         uint level,
-        /// 1: the pass runs over the level's appended nodes only.
-        uint appended_only,
-        /// Unused.
-        uint pad1,
+        /// Which of the level's nodes: `SVO_OVER_LEVEL`, `SVO_OVER_APPENDED` or `SVO_OVER_LIST`.
+        uint over,
+        /// With `SVO_OVER_LIST`: the update list.
+        uint list,
         /// Unused.
         uint pad2,
     }

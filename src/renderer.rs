@@ -392,6 +392,12 @@ impl Renderer {
         Ok(renderer)
     }
 
+    /// The first frame's descriptor set (set 0), for passes a test records itself.
+    #[cfg(test)]
+    pub fn first_frame_set(&self) -> vk::DescriptorSet {
+        self.frames[0].set
+    }
+
     fn create_targets(ctx: &Arc<Context>, extent: vk::Extent2D) -> Result<Targets> {
         Ok(Targets {
             gbuffer: GBuffer::new(ctx, extent)?,

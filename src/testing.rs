@@ -31,6 +31,17 @@ pub fn render_frames(
     settings: RenderSettings,
     times: &[f32],
 ) -> (Arc<Context>, Renderer) {
+    render_frames_with(scene, settings, times, |_, _| {})
+}
+
+/// As [`render_frames`], with `before(renderer, i)` called before frame i is recorded
+/// (to move a light, say).
+pub fn render_frames_with(
+    scene: Scene,
+    settings: RenderSettings,
+    times: &[f32],
+    mut before: impl FnMut(&mut Renderer, usize),
+) -> (Arc<Context>, Renderer) {
     let _ = env_logger::builder().is_test(true).try_init();
     let ctx = Context::new(&ContextOptions {
         validation: true,
@@ -59,6 +70,7 @@ pub fn render_frames(
             },
             ..target
         };
+        before(&mut renderer, i);
         let frame = renderer.begin_frame().unwrap();
         renderer.record_frame(&frame, time, &target).unwrap();
         renderer.submit(frame, None, None).unwrap();

@@ -35,6 +35,10 @@ struct ListedVoxel {
     ivec3 texel;
     // Of its radiance.
     ivec3 radiance_texel;
+#ifdef VOXELS_SVO
+    // Its leaf's brick.
+    uint brick;
+#endif
 };
 
 // The voxel of this invocation's entry; false past the end of the list.
@@ -47,6 +51,7 @@ bool listed_voxel(out ListedVoxel entry) {
     entry.voxel = ivec3(v & 0x3ffu, (v >> 10) & 0x3ffu, v >> 20);
 #ifdef VOXELS_SVO
     uint brick = list_voxels[VOXEL_LIST_STRIDE * index + 1u];
+    entry.brick = brick;
     ivec3 within = entry.voxel & 1;
     entry.texel = brick_origin(brick, counters.leaf_pool_side, SVO_ATTRIBUTE_BRICK) + within;
     entry.radiance_texel = brick_origin(brick, counters.leaf_pool_side, SVO_RADIANCE_BRICK) + 1 + within;

@@ -39,6 +39,13 @@ layout(set = SET_PASS, binding = BINDING_SVO_CARRY, std430) buffer CarryBlock {
 layout(set = SET_PASS, binding = BINDING_SVO_STATIC_NODES, std430) readonly buffer StaticBlock {
     uint static_children[];
 };
+layout(set = SET_PASS, binding = BINDING_SVO_CHANGES, std430) buffer ChangesBlock {
+    uint brick_changes[];
+};
+layout(set = SET_PASS, binding = BINDING_SVO_UPDATES, std430) buffer UpdatesBlock {
+    SvoUpdateList update_lists[SVO_UPDATE_LISTS];
+    uint update_nodes[];
+};
 
 // Mask of a child entry's tile index.
 #define SVO_CHILD_MASK (~SVO_SUBDIVIDE)
@@ -99,6 +106,58 @@ bool leaf_texel(uvec3 v, out ivec3 texel) {
     uint side = counters.leaf_pool_side;
     texel = ivec3(brick % side, (brick / side) % side, brick / (side * side)) * int(SVO_ATTRIBUTE_BRICK) + ivec3(v & 1u);
     return true;
+}
+
+// The node at `level` at offset `step` (each -1, 0 or 1) from `node` at `coords`: through
+// the neighbour pointers (one to three hops), or searched from the root where a hop meets
+// no link (a diagonal neighbour can exist beside missing face neighbours; a static node
+// has no links to the nodes a frame appends).
+uint offset_node(uint node, ivec3 coords, ivec3 step, uint level) {
+    uint n = node;
+    for (int axis = 0; axis < 3 && n != SVO_NO_NODE; axis++) {
+        if (step[axis] != 0) {
+            n = node_neighbours[6u * n + uint(2 * axis + (step[axis] > 0 ? 0 : 1))];
+        }
+    }
+    if (n == SVO_NO_NODE) {
+        ivec3 at = coords + step;
+        int side = 1 << level;
+        if (any(lessThan(at, ivec3(0))) || any(greaterThanEqual(at, ivec3(side)))) {
+            return SVO_NO_NODE;
+        }
+        n = find_node(uvec3(at) << (svo_depth() - level), level);
+    }
+    return n;
+}
+
+// The filter's update lists (Dřínovský 2013, 5.5), by level parity: which nodes changed
+// (`SVO_CHANGED`) and whose borders must be copied again (`SVO_BORDER`). A brick's change
+// word records the bits already given, so each node enters a list once.
+uint changed_list(uint level) {
+    return level & 1u;
+}
+
+uint border_list(uint level) {
+    return 2u + (level & 1u);
+}
+
+uint change_slot(uint brick, uint level) {
+    return level + 1u == svo_depth() ? brick : counters.leaf_brick_capacity + brick;
+}
+
+// Gives `node` (of `level`, with `brick`) `bit`, and appends it to `list` the first time.
+void mark_node(uint node, uint brick, uint level, uint bit, uint list) {
+    if ((atomicOr(brick_changes[change_slot(brick, level)], bit) & bit) != 0u) {
+        return;
+    }
+    uint i = atomicAdd(update_lists[list].count, 1u);
+    if (i >= counters.update_capacity) {
+        return;
+    }
+    update_nodes[list * counters.update_capacity + i] = node;
+    if (i % SVO_GROUP_SIZE == 0u) {
+        atomicMax(update_lists[list].groups_x, i / SVO_GROUP_SIZE + 1u);
+    }
 }
 
 // The carried light tables (open addressing, linear probing; 4 words an entry): the

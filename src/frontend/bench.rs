@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use anyhow::{Context as _, Result};
+use anyhow::{bail, Context as _, Result};
 use ash::vk;
 use serde::Serialize;
 
@@ -86,7 +86,18 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
     let mut totals = Vec::new();
     let mut walls = Vec::new();
     let total_frames = args.warmup + args.frames;
+    let bounds = renderer.scene.bounds(args.common.time);
+    let radius = 0.05 * (bounds.max - bounds.min).length();
+    let light_start = renderer.scene.lights.first().map(|l| l.position);
+    if args.move_light && light_start.is_none() {
+        bail!("--move-light: the scene has no light");
+    }
     for index in 0..total_frames {
+        if let (true, Some(centre)) = (args.move_light, light_start) {
+            let angle = std::f32::consts::TAU * index as f32 / 60.0;
+            renderer.scene.lights[0].position =
+                centre + radius * glam::Vec3::new(angle.cos() - 1.0, 0.0, angle.sin());
+        }
         let start = Instant::now();
         let frame = renderer.begin_frame()?;
         renderer.record_frame(&frame, args.common.time, &target)?;

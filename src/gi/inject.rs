@@ -5,7 +5,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
-use crate::gpu_layout as layout;
+use crate::gpu_layout::{self as layout, InjectPush};
 use crate::vk::{Context, Pipeline};
 
 pub struct InjectPass {
@@ -30,20 +30,30 @@ impl InjectPass {
         } else {
             (s::GI_INJECT_INJECT_COMP, s::GI_INJECT_BOUNCE_COMP)
         };
-        let pipeline = Pipeline::compute(ctx, "inject", inject, &set_layouts, 0)?;
+        let push = std::mem::size_of::<InjectPush>() as u32;
+        let pipeline = Pipeline::compute(ctx, "inject", inject, &set_layouts, push)?;
         let bounce = Pipeline::compute(ctx, "bounce", bounce, &set_layouts, 0)?;
         Ok(Self { pipeline, bounce })
     }
 
-    /// Shades every voxel of the occupied-voxel list (`list`, which holds the dispatch).
+    /// Shades every voxel of the occupied-voxel list (`list`, which holds the dispatch);
+    /// `store_radiance`: the radiance too, not only the direct light (false when a bounce
+    /// rewrites it before the next filter).
     pub fn record(
         &self,
         cmd: vk::CommandBuffer,
         frame_set: vk::DescriptorSet,
         gi_set: vk::DescriptorSet,
         list: vk::Buffer,
+        store_radiance: bool,
     ) {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
+        let push = InjectPush {
+            store_radiance: u32::from(store_radiance),
+            ..Default::default()
+        };
+        self.pipeline
+            .push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
         self.pipeline.dispatch_indirect(cmd, &sets, list, 0);
     }
 

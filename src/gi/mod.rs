@@ -766,6 +766,12 @@ impl VoxelGi {
         Ok(())
     }
 
+    /// The GI descriptor set (set 2), for passes a test records itself.
+    #[cfg(test)]
+    pub fn set(&self) -> vk::DescriptorSet {
+        self.set
+    }
+
     /// The octree, with `--gi svo`.
     pub fn octree(&self) -> Option<&SvoGi> {
         match &self.voxels {
@@ -918,7 +924,10 @@ impl VoxelGi {
         );
         // Last frame's cone tracing sampled the radiance volumes that are rewritten now.
         compute_to_compute(ctx, cmd);
-        self.inject.record(cmd, draw.frame_set, set, list);
+        // Unless a bounce rewrites the radiance before the filter reads it.
+        let filter_now = !self.history || rebuilt;
+        self.inject
+            .record(cmd, draw.frame_set, set, list, filter_now);
         timer.end(cmd);
 
         let filter = |voxels: &Voxels| match voxels {
@@ -928,7 +937,7 @@ impl VoxelGi {
         let bounces = if self.history { 1 } else { self.bounces - 1 };
         // A rebuilt octree's bricks are new: its voxel shading started from the light
         // carried by voxel, which is filtered before the bounce.
-        if !self.history || rebuilt {
+        if filter_now {
             timer.begin(cmd, "filter");
             compute_to_compute(ctx, cmd);
             filter(&self.voxels);
@@ -939,6 +948,8 @@ impl VoxelGi {
             timer.begin(cmd, "bounce");
             compute_to_compute(ctx, cmd);
             self.inject.record_bounce(cmd, draw.frame_set, set, list);
+            timer.end(cmd);
+            timer.begin(cmd, "bounce filter");
             compute_to_compute(ctx, cmd);
             filter(&self.voxels);
             timer.end(cmd);

@@ -1,7 +1,9 @@
 //! The bricks (`glsl/svo/bricks/`): leaf bricks filled from the voxel fragments
 //! (`fill.comp`), the list of occupied leaf voxels that voxel shading runs over
 //! (`compact.comp`), interior bricks filtered bottom-up (`filter.comp`) and every brick's
-//! border copied from its neighbours (`apron.comp`).
+//! border copied from its neighbours (`apron.comp`); after voxel shading, either all of
+//! them or only the nodes on the update lists (`spread.comp` builds them level by level
+//! from the leaves whose radiance changed).
 //!
 //! A brick holds its node's 2x2x2 voxels at voxel centres, exactly as the dense grid holds
 //! them, so both paths read the same values and share their CPU references; the radiance
@@ -16,16 +18,78 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
-use super::octree::{dispatch_for_level, Over};
+use super::octree::{compute_to_indirect, dispatch_for_level, Over};
 use crate::gi::compute_to_compute;
-use crate::gpu_layout::SvoPush;
-use crate::vk::{Context, Pipeline};
+use crate::gpu_layout::{self as layout, SvoPush, SvoUpdateList};
+use crate::vk::{stage_barrier, Context, Pipeline};
+
+/// Byte offset of update list `list`'s head (its indirect dispatch) in the update buffer.
+fn list_offset(list: u32) -> vk::DeviceSize {
+    u64::from(list) * std::mem::size_of::<SvoUpdateList>() as u64
+}
+
+/// Records emptying update lists `lists` of `updates` (a transfer, between compute
+/// passes).
+pub fn reset_update_lists(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    updates: vk::Buffer,
+    lists: &[u32],
+) {
+    let empty = SvoUpdateList {
+        groups_y: 1,
+        groups_z: 1,
+        ..Default::default()
+    };
+    stage_barrier(
+        ctx,
+        cmd,
+        vk::PipelineStageFlags2::ALL_COMMANDS,
+        vk::PipelineStageFlags2::ALL_TRANSFER,
+    );
+    for &list in lists {
+        unsafe {
+            ctx.device.cmd_update_buffer(
+                cmd,
+                updates,
+                list_offset(list),
+                bytemuck::bytes_of(&empty),
+            )
+        };
+    }
+    stage_barrier(
+        ctx,
+        cmd,
+        vk::PipelineStageFlags2::ALL_TRANSFER,
+        vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
+    );
+}
+
+/// Pushes `level` to `pipeline` and dispatches it over update list `list` of `updates`.
+fn dispatch_for_list(
+    pipeline: &Pipeline,
+    cmd: vk::CommandBuffer,
+    sets: &[(u32, vk::DescriptorSet)],
+    level: u32,
+    updates: vk::Buffer,
+    list: u32,
+) {
+    let push = SvoPush {
+        level,
+        over: layout::SVO_OVER_LIST,
+        list,
+        ..Default::default()
+    };
+    pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
+    pipeline.dispatch_indirect(cmd, sets, updates, list_offset(list));
+}
 
 pub struct BrickPasses {
     fill: Pipeline,
     list: Pipeline,
     filter: Pipeline,
     apron: Pipeline,
+    spread: Pipeline,
 }
 
 impl BrickPasses {
@@ -39,6 +103,7 @@ impl BrickPasses {
             list: pipeline("svo voxel list", s::SVO_BRICKS_COMPACT_COMP)?,
             filter: pipeline("svo filter", s::SVO_BRICKS_FILTER_COMP)?,
             apron: pipeline("svo apron", s::SVO_BRICKS_APRON_COMP)?,
+            spread: pipeline("svo spread", s::SVO_BRICKS_SPREAD_COMP)?,
         })
     }
 
@@ -80,6 +145,38 @@ impl BrickPasses {
             dispatch_for_level(&self.filter, cmd, sets, level, counters, Over::Level);
             compute_to_compute(ctx, cmd);
             dispatch_for_level(&self.apron, cmd, sets, level, counters, Over::Level);
+        }
+    }
+
+    /// Filters only what changed, bottom-up from the leaves that voxel shading put on
+    /// the changed list of their level: per level, the changed nodes put themselves and
+    /// their 26 neighbours on the level's border list and their parents on the changed
+    /// list above; the border list gets its borders, the changed parents are filtered.
+    pub fn record_update(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        sets: &[(u32, vk::DescriptorSet)],
+        updates: vk::Buffer,
+        depth: u32,
+    ) {
+        for level in (0..depth).rev() {
+            let changed = level & 1;
+            let border = 2 + changed;
+            let filled: &[u32] = if level > 0 {
+                &[border, changed ^ 1]
+            } else {
+                &[border]
+            };
+            reset_update_lists(ctx, cmd, updates, filled);
+            dispatch_for_list(&self.spread, cmd, sets, level, updates, changed);
+            compute_to_indirect(ctx, cmd);
+            dispatch_for_list(&self.apron, cmd, sets, level, updates, border);
+            if level > 0 {
+                compute_to_compute(ctx, cmd);
+                dispatch_for_list(&self.filter, cmd, sets, level - 1, updates, changed ^ 1);
+            }
+            compute_to_compute(ctx, cmd);
         }
     }
 }

@@ -20,7 +20,7 @@ use gpu_allocator::MemoryLocation;
 
 use crate::gi::voxelize::{Meshes, VoxelizePass};
 use crate::gi::{compute_to_compute, reset_voxel_list, Grid};
-use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel, VoxelListHeader};
+use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel, SvoUpdateList, VoxelListHeader};
 use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
@@ -246,6 +246,10 @@ struct Pools {
     /// moving meshes): every frame restores them before it inserts the moving meshes.
     static_children: Buffer,
     static_bricks: Buffer,
+    /// Per brick, its change bits while the filter's update lists are built.
+    changes: Buffer,
+    /// The filter's update lists: their heads, then `capacities.nodes` nodes each.
+    updates: Buffer,
     /// The images have been cleared once (they are in GENERAL layout since, read and
     /// written by any pass of earlier frames).
     cleared: std::cell::Cell<bool>,
@@ -253,6 +257,10 @@ struct Pools {
 
 const COUNTERS_BYTES: usize = std::mem::size_of::<SvoCounters>()
     + layout::SVO_MAX_LEVELS as usize * std::mem::size_of::<SvoLevel>();
+
+/// The update lists' heads, at the start of `Pools::updates`.
+const UPDATE_HEADS_BYTES: u64 =
+    layout::SVO_UPDATE_LISTS as u64 * std::mem::size_of::<SvoUpdateList>() as u64;
 
 /// The radiance pools between passes: written as storage, sampled by cones.
 const RADIANCE_USE: ImageUse = ImageUse {
@@ -377,6 +385,16 @@ impl Pools {
                 if moving { 4 * nodes } else { 4 },
                 vk::BufferUsageFlags::empty(),
             )?,
+            changes: buffer(
+                "svo brick changes",
+                4 * (u64::from(capacities.leaf_bricks) + u64::from(capacities.interior_bricks)),
+                vk::BufferUsageFlags::empty(),
+            )?,
+            updates: buffer(
+                "svo update lists",
+                UPDATE_HEADS_BYTES + 4 * u64::from(layout::SVO_UPDATE_LISTS) * nodes,
+                vk::BufferUsageFlags::INDIRECT_BUFFER,
+            )?,
         })
     }
 
@@ -398,6 +416,8 @@ impl Pools {
                 storage,
                 self.static_children.raw,
             )
+            .buffer(layout::BINDING_SVO_CHANGES, storage, self.changes.raw)
+            .buffer(layout::BINDING_SVO_UPDATES, storage, self.updates.raw)
             .storage_image(layout::BINDING_GI_ALBEDO, albedo.view)
             .storage_image(layout::BINDING_GI_NORMAL, normal.view)
             .storage_image(layout::BINDING_GI_EMISSION, emission.view)
@@ -456,6 +476,7 @@ impl Pools {
                 "svo_static_nodes",
                 self.static_children.size + self.static_bricks.size,
             ),
+            ("svo_update_lists", self.changes.size + self.updates.size),
         ]
     }
 }
@@ -577,6 +598,8 @@ pub fn bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_SVO_SUMS, storage, all),
         Binding::new(layout::BINDING_SVO_CARRY, storage, all),
         Binding::new(layout::BINDING_SVO_STATIC_NODES, storage, all),
+        Binding::new(layout::BINDING_SVO_CHANGES, storage, all),
+        Binding::new(layout::BINDING_SVO_UPDATES, storage, all),
         Binding::new(
             layout::BINDING_SVO_DIRECTIONAL_STORAGE,
             vk::DescriptorType::STORAGE_IMAGE,
@@ -704,7 +727,11 @@ impl SvoGi {
     }
 
     /// Filters the leaf radiance up the tree, bottom-up, with the bricks' borders copied
-    /// from their neighbours at every level (after voxel shading or a bounce).
+    /// from their neighbours at every level (after voxel shading or a bounce). Around
+    /// moving meshes every node is filtered (a node whose subtree lost a moving mesh's
+    /// nodes must be too, and nothing lists it); otherwise only the nodes on the update
+    /// lists, which start from the leaves whose radiance voxel shading changed
+    /// (Dřínovský 2013, 5.5).
     pub fn record_filter(
         &self,
         cmd: vk::CommandBuffer,
@@ -712,8 +739,33 @@ impl SvoGi {
         set: vk::DescriptorSet,
     ) {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, set)];
-        self.bricks
-            .record_filter(&self.ctx, cmd, &sets, self.counters.raw, self.depth);
+        let ctx = &self.ctx;
+        let counters = self.counters.raw;
+        if self.moving() {
+            self.bricks
+                .record_filter(ctx, cmd, &sets, counters, self.depth);
+        } else {
+            let updates = self.pools.updates.raw;
+            self.bricks
+                .record_update(ctx, cmd, &sets, updates, self.depth);
+        }
+        // Empty lists for the next voxel shading (after a full filter, also the change
+        // bits voxel shading gave).
+        if self.moving() {
+            stage_barrier(
+                ctx,
+                cmd,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+            );
+            let changes = self.pools.changes.raw;
+            unsafe {
+                ctx.device
+                    .cmd_fill_buffer(cmd, changes, 0, vk::WHOLE_SIZE, 0)
+            };
+        }
+        let all: Vec<u32> = (0..layout::SVO_UPDATE_LISTS).collect();
+        bricks::reset_update_lists(ctx, cmd, self.pools.updates.raw, &all);
     }
 
     /// The last build's report.
@@ -1032,6 +1084,7 @@ impl SvoGi {
             fragment_base: base,
             static_node_count: part.nodes,
             static_leaf_bricks: part.leaf_bricks,
+            update_capacity: c.nodes,
             ..Default::default()
         };
         let mut head = bytemuck::bytes_of(&counters).to_vec();
@@ -1061,6 +1114,10 @@ impl SvoGi {
             if sums_kept < p.sums.size {
                 device.cmd_fill_buffer(cmd, p.sums.raw, sums_kept, vk::WHOLE_SIZE, 0);
             }
+            if !part.saved {
+                // A build: no brick changed yet.
+                device.cmd_fill_buffer(cmd, p.changes.raw, 0, vk::WHOLE_SIZE, 0);
+            }
         }
         stage_barrier(
             ctx,
@@ -1070,6 +1127,10 @@ impl SvoGi {
                 | vk::PipelineStageFlags2::COMPUTE_SHADER
                 | vk::PipelineStageFlags2::DRAW_INDIRECT,
         );
+        if !part.saved {
+            let all: Vec<u32> = (0..layout::SVO_UPDATE_LISTS).collect();
+            bricks::reset_update_lists(ctx, cmd, p.updates.raw, &all);
+        }
     }
 
     /// Records the octree's levels from the fragments (`record_start` wrote where they
@@ -1267,6 +1328,17 @@ const BRICK_USE: ImageUse = ImageUse {
 
 #[cfg(test)]
 impl SvoGi {
+    /// Filters every node, whatever the update lists hold, and waits.
+    fn full_filter(&self, frame_set: vk::DescriptorSet, set: vk::DescriptorSet) -> Result<()> {
+        let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, set)];
+        OneShot::new(&self.ctx)?.run("full svo filter", |cmd| {
+            compute_to_compute(&self.ctx, cmd);
+            self.bricks
+                .record_filter(&self.ctx, cmd, &sets, self.counters.raw, self.depth);
+            Ok(())
+        })
+    }
+
     /// Downloads a pool buffer as `u32` words.
     fn download_words(&self, buffer: &Buffer) -> Result<Vec<u32>> {
         let bytes = crate::vk::read_back_buffer(&self.ctx, buffer)?;

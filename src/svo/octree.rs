@@ -12,7 +12,7 @@ use anyhow::Result;
 use ash::vk;
 
 use crate::gi::compute_to_compute;
-use crate::gpu_layout::{SvoCounters, SvoLevel, SvoPush};
+use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel, SvoPush};
 use crate::vk::{memory_barrier, Context, GpuTimer, Pipeline};
 
 /// Byte offset of level `level`'s entry (its indirect dispatch) in the counters buffer.
@@ -44,7 +44,11 @@ pub fn dispatch_for_level(
 ) {
     let push = SvoPush {
         level,
-        appended_only: u32::from(over == Over::Appended),
+        over: if over == Over::Appended {
+            layout::SVO_OVER_APPENDED
+        } else {
+            layout::SVO_OVER_LEVEL
+        },
         ..Default::default()
     };
     let offset = match over {
@@ -68,7 +72,7 @@ pub struct OctreePasses {
 
 /// Makes the level table written by a compute pass readable as indirect dispatches and by
 /// the next compute pass.
-fn compute_to_indirect(ctx: &Context, cmd: vk::CommandBuffer) {
+pub(super) fn compute_to_indirect(ctx: &Context, cmd: vk::CommandBuffer) {
     memory_barrier(
         ctx,
         cmd,

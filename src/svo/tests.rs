@@ -10,7 +10,7 @@ use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel};
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
-use crate::testing::{gi_settings, moving_cube_scene, render_frames};
+use crate::testing::{gi_settings, moving_cube_scene, render_frames, render_frames_with};
 use crate::vk::Context;
 
 /// A renderer whose octree of `scene` is built at `depth`, after `frames` frames.
@@ -855,4 +855,60 @@ fn carried_light_converges_to_all_bounces() {
     }
     assert_eq!(ctx.validation_messages(), 0);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The update lists filter only what changed, yet leave the filtered levels (and every
+/// brick's border) exactly as a full filter of the leaves as stored would: after frames
+/// whose light moved, and after frames with it still. The first frames add bounces too.
+#[test]
+fn update_lists_filter_what_changed() {
+    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+        return;
+    };
+    let scene = Scene::load(&path, &LoadOptions::REFERENCE).unwrap();
+    let settings = gi_settings(64, VoxelStructure::Octree { capacities: None }, false);
+    for still in [0, 3] {
+        let (ctx, renderer) =
+            render_frames_with(scene.clone(), settings.clone(), &[0.0; 6], |renderer, i| {
+                if i < 6 - still {
+                    renderer.scene.lights[0].position.x += 0.05;
+                }
+            });
+        let gi = renderer.gi().unwrap();
+        let svo = gi.octree().unwrap();
+        let images = || {
+            [&svo.pools.leaf_radiance, &svo.pools.directional].map(|image| {
+                crate::vk::read_back_image(
+                    &svo.ctx,
+                    image,
+                    0,
+                    image.desc.extent,
+                    8,
+                    super::RADIANCE_USE,
+                )
+                .unwrap()
+            })
+        };
+        let listed = images();
+        svo.full_filter(renderer.first_frame_set(), gi.set())
+            .unwrap();
+        let full = images();
+        for (name, (a, b)) in ["leaf radiance", "directional"]
+            .iter()
+            .zip(listed.iter().zip(&full))
+        {
+            let a: &[u16] = bytemuck::cast_slice(a);
+            let b: &[u16] = bytemuck::cast_slice(b);
+            let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+            let nonzero = b.iter().filter(|&&x| x != 0).count();
+            eprintln!(
+                "light still for {still} frames: {name}: {differ} of {} values differ from a \
+                 full filter ({nonzero} nonzero)",
+                a.len()
+            );
+            assert_eq!(differ, 0, "{name}: the update lists missed changes");
+            assert!(nonzero > 0);
+        }
+        assert_eq!(ctx.validation_messages(), 0);
+    }
 }

@@ -6,13 +6,12 @@
 // radiance.
 // Cones read only the directional levels (lod >= 1), never the base level rewritten here.
 #include "gi/cones.glsl"
-#include "gi/voxel_list.glsl"
+#include "gi/inject/radiance.glsl"
 
 layout(local_size_x = VOXEL_LIST_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform readonly uimage3D voxel_albedo;
 layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform readonly uimage3D voxel_normal;
 layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform readonly image3D voxel_direct;
-layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance_out;
 
 // Cones per voxel gather, whatever --diffuse-cones asks of the screen: six cover the
 // hemisphere well enough for light that is filtered again before anyone sees it.
@@ -36,5 +35,5 @@ void main() {
         carry_store(uvec3(entry.voxel), gathered);
     }
 #endif
-    imageStore(voxel_radiance_out, entry.radiance_texel, vec4(direct.rgb + albedo.rgb / 255.0 * gathered, direct.a));
+    store_radiance(entry, vec4(direct.rgb + albedo.rgb / 255.0 * gathered, direct.a));
 }

@@ -6,17 +6,20 @@
 // premultiplied by opacity. Visibility comes from the shadow maps (one bilinear compare:
 // a voxel is wider than the PCF kernel), or with soft-shadow cones, which make the
 // shadow maps unnecessary, from a ray marched through the voxels towards the light.
-// With VOXELS_SVO the voxels are the octree's leaf voxels, in their bricks.
+// With VOXELS_SVO the voxels are the octree's leaf voxels, in their bricks. The radiance
+// is stored only where a bounce does not rewrite it before the next filter.
 #include "common/frame.glsl"
 #include "common/direct_light.glsl"
 #include "gi/voxels.glsl"
-#include "gi/voxel_list.glsl"
+#include "gi/inject/radiance.glsl"
 
 layout(local_size_x = VOXEL_LIST_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform readonly uimage3D voxel_albedo;
 layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform uimage3D voxel_normal;
 layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform readonly uimage3D voxel_emission;
-layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance;
+layout(push_constant) uniform PushBlock {
+    InjectPush push;
+};
 layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform writeonly image3D voxel_direct;
 
 // Whether voxel v of the grid holds a surface.
@@ -109,5 +112,7 @@ void main() {
         radiance.rgb += rho * carry_load(uvec3(entry.voxel));
     }
 #endif
-    imageStore(voxel_radiance, entry.radiance_texel, radiance);
+    if (push.store_radiance != 0u) {
+        store_radiance(entry, radiance);
+    }
 }

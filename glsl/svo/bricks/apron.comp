@@ -5,25 +5,12 @@
 // grid would. The neighbour holding a border voxel is reached through the neighbour
 // pointers (one to three hops); where a hop meets no node, the octree is searched from
 // the root (a diagonal neighbour can exist beside missing face neighbours). At the grid's
-// edge the border repeats the edge voxel, as the dense sampler clamps to its edge.
+// edge the border repeats the edge voxel, as the dense sampler clamps to its edge. Over
+// an update list, the node's change bits are cleared for the next filter.
 #include "svo/octree/level.glsl"
 
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform image3D leaf_radiance;
 layout(set = SET_PASS, binding = BINDING_SVO_DIRECTIONAL_STORAGE, rgba16f) uniform image3D directional;
-
-// The node of this level at offset `step` (each -1, 0 or 1) from `node` at `coords`.
-uint offset_node(uint node, ivec3 coords, ivec3 step) {
-    uint n = node;
-    for (int axis = 0; axis < 3 && n != SVO_NO_NODE; axis++) {
-        if (step[axis] != 0) {
-            n = node_neighbours[6u * n + uint(2 * axis + (step[axis] > 0 ? 0 : 1))];
-        }
-    }
-    if (n == SVO_NO_NODE) {
-        n = find_node(uvec3(coords + step) << (svo_depth() - push.level), push.level);
-    }
-    return n;
-}
 
 void main() {
     uint node;
@@ -43,7 +30,7 @@ void main() {
         }
         ivec3 g = clamp(coords * 2 + t, ivec3(0), ivec3(last));
         ivec3 step = (g >> 1) - coords;
-        uint owner = all(equal(step, ivec3(0))) ? node : offset_node(node, coords, step);
+        uint owner = all(equal(step, ivec3(0))) ? node : offset_node(node, coords, step, push.level);
         uint brick = owner == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[owner];
         ivec3 from = brick == SVO_NO_BRICK ? ivec3(0) : brick_origin(brick, side, SVO_RADIANCE_BRICK) + 1 + (g & 1);
         if (leaf) {
@@ -57,4 +44,5 @@ void main() {
             }
         }
     }
+    brick_changes[change_slot(node_bricks[node], push.level)] = 0u;
 }

@@ -1,6 +1,6 @@
 // The passes that run over the nodes of one level (`push.level`), dispatched indirectly
-// from that level's entry in the level table: over both of its runs of nodes (static,
-// then appended), or over the appended run only (`push.appended_only`).
+// from that level's entry in the level table (over both of its runs of nodes, static then
+// appended, or over the appended run only) or from an update list's head.
 #ifndef SVO_LEVEL_GLSL
 #define SVO_LEVEL_GLSL
 #include "svo/octree.glsl"
@@ -10,11 +10,15 @@ layout(push_constant) uniform PushBlock {
     SvoPush push;
 };
 
-// This invocation's node; false past the end of the level.
+// This invocation's node; false past the end of the level or list.
 bool level_node(out uint node) {
-    SvoLevel level = levels[push.level];
     uint i = gl_GlobalInvocationID.x;
-    uint statics = push.appended_only != 0u ? 0u : level.count;
+    if (push.over == SVO_OVER_LIST) {
+        node = i < counters.update_capacity ? update_nodes[push.list * counters.update_capacity + i] : SVO_NO_NODE;
+        return i < min(update_lists[push.list].count, counters.update_capacity);
+    }
+    SvoLevel level = levels[push.level];
+    uint statics = push.over == SVO_OVER_APPENDED ? 0u : level.count;
     if (i < statics) {
         node = level.first + i;
         return true;

@@ -1,0 +1,33 @@
+// Where voxel shading and the bounces leave each listed voxel's radiance. In the octree a
+// store that would change the radiance by less than `RADIANCE_CHANGE` (relative, per
+// channel) is skipped, and a voxel whose radiance changes puts its leaf on the filter's
+// update list (Dřínovský 2013, 5.5): only what changed is filtered again up the tree.
+// The stored value stays within that tolerance of the shaded one, and the filtered levels
+// always match the stored leaves.
+#ifndef INJECT_RADIANCE_GLSL
+#define INJECT_RADIANCE_GLSL
+#include "gi/voxel_list.glsl"
+
+layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform image3D shaded_radiance;
+
+// Above one half-float step (2^-10 relative), so that a converged voxel stays unchanged.
+const float RADIANCE_CHANGE = 1.0 / 512.0;
+
+void store_radiance(ListedVoxel entry, vec4 radiance) {
+#ifdef VOXELS_SVO
+    vec4 stored = imageLoad(shaded_radiance, entry.radiance_texel);
+    vec4 tolerance = max(abs(stored), abs(radiance)) * RADIANCE_CHANGE;
+    if (all(lessThanEqual(abs(radiance - stored), tolerance))) {
+        return;
+    }
+    imageStore(shaded_radiance, entry.radiance_texel, radiance);
+    uint level = svo_depth() - 1u;
+    uint node = find_node(uvec3(entry.voxel), level);
+    if (node != SVO_NO_NODE) {
+        mark_node(node, entry.brick, level, SVO_CHANGED, changed_list(level));
+    }
+#else
+    imageStore(shaded_radiance, entry.radiance_texel, radiance);
+#endif
+}
+#endif
