@@ -930,18 +930,23 @@ impl VoxelGi {
             .record(cmd, draw.frame_set, set, list, filter_now);
         timer.end(cmd);
 
-        let filter = |voxels: &Voxels| match voxels {
-            Voxels::Dense(dense) => dense.filter.record(ctx, cmd, n),
-            Voxels::Octree(svo) => svo.record_filter(cmd, draw.frame_set, set),
+        // The dense filter is one pass; the octree's are timed per level.
+        let filter = |voxels: &Voxels, timer: &mut GpuTimer, name: &str| {
+            compute_to_compute(ctx, cmd);
+            match voxels {
+                Voxels::Dense(dense) => {
+                    timer.begin(cmd, name);
+                    dense.filter.record(ctx, cmd, n);
+                    timer.end(cmd);
+                }
+                Voxels::Octree(svo) => svo.record_filter(cmd, timer, draw.frame_set, set),
+            }
         };
         let bounces = if self.history { 1 } else { self.bounces - 1 };
         // A rebuilt octree's bricks are new: its voxel shading started from the light
         // carried by voxel, which is filtered before the bounce.
         if filter_now {
-            timer.begin(cmd, "filter");
-            compute_to_compute(ctx, cmd);
-            filter(&self.voxels);
-            timer.end(cmd);
+            filter(&self.voxels, timer, "filter");
         }
         self.history = self.accumulate_bounces;
         for _ in 0..bounces {
@@ -949,10 +954,7 @@ impl VoxelGi {
             compute_to_compute(ctx, cmd);
             self.inject.record_bounce(cmd, draw.frame_set, set, list);
             timer.end(cmd);
-            timer.begin(cmd, "bounce filter");
-            compute_to_compute(ctx, cmd);
-            filter(&self.voxels);
-            timer.end(cmd);
+            filter(&self.voxels, timer, "bounce filter");
         }
         Ok(())
     }

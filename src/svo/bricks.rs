@@ -21,7 +21,7 @@ use ash::vk;
 use super::octree::{compute_to_indirect, dispatch_for_level, Over};
 use crate::gi::compute_to_compute;
 use crate::gpu_layout::{self as layout, SvoPush, SvoUpdateList};
-use crate::vk::{stage_barrier, Context, Pipeline};
+use crate::vk::{stage_barrier, Context, GpuTimer, Pipeline};
 
 /// Byte offset of update list `list`'s head (its indirect dispatch) in the update buffer.
 fn list_offset(list: u32) -> vk::DeviceSize {
@@ -134,17 +134,22 @@ impl BrickPasses {
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
         sets: &[(u32, vk::DescriptorSet)],
         counters: vk::Buffer,
         depth: u32,
     ) {
-        let leaves = depth - 1;
-        dispatch_for_level(&self.apron, cmd, sets, leaves, counters, Over::Level);
-        for level in (0..leaves).rev() {
-            compute_to_compute(ctx, cmd);
-            dispatch_for_level(&self.filter, cmd, sets, level, counters, Over::Level);
-            compute_to_compute(ctx, cmd);
+        for level in (0..depth).rev() {
+            if level + 1 < depth {
+                timer.begin(cmd, &format!("filter {level}"));
+                dispatch_for_level(&self.filter, cmd, sets, level, counters, Over::Level);
+                compute_to_compute(ctx, cmd);
+                timer.end(cmd);
+            }
+            timer.begin(cmd, &format!("border {level}"));
             dispatch_for_level(&self.apron, cmd, sets, level, counters, Over::Level);
+            compute_to_compute(ctx, cmd);
+            timer.end(cmd);
         }
     }
 
@@ -156,6 +161,7 @@ impl BrickPasses {
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
         sets: &[(u32, vk::DescriptorSet)],
         updates: vk::Buffer,
         depth: u32,
@@ -168,15 +174,21 @@ impl BrickPasses {
             } else {
                 &[border]
             };
+            timer.begin(cmd, &format!("spread {level}"));
             reset_update_lists(ctx, cmd, updates, filled);
             dispatch_for_list(&self.spread, cmd, sets, level, updates, changed);
             compute_to_indirect(ctx, cmd);
+            timer.end(cmd);
+            timer.begin(cmd, &format!("border {level}"));
             dispatch_for_list(&self.apron, cmd, sets, level, updates, border);
-            if level > 0 {
-                compute_to_compute(ctx, cmd);
-                dispatch_for_list(&self.filter, cmd, sets, level - 1, updates, changed ^ 1);
-            }
             compute_to_compute(ctx, cmd);
+            timer.end(cmd);
+            if level > 0 {
+                timer.begin(cmd, &format!("filter {}", level - 1));
+                dispatch_for_list(&self.filter, cmd, sets, level - 1, updates, changed ^ 1);
+                compute_to_compute(ctx, cmd);
+                timer.end(cmd);
+            }
         }
     }
 }

@@ -732,9 +732,11 @@ impl SvoGi {
     /// nodes must be too, and nothing lists it); otherwise only the nodes on the update
     /// lists, which start from the leaves whose radiance voxel shading changed
     /// (Dřínovský 2013, 5.5).
+    /// Each level's passes are timed apart: `spread L`, `border L` and `filter L`.
     pub fn record_filter(
         &self,
         cmd: vk::CommandBuffer,
+        timer: &mut GpuTimer,
         frame_set: vk::DescriptorSet,
         set: vk::DescriptorSet,
     ) {
@@ -743,11 +745,11 @@ impl SvoGi {
         let counters = self.counters.raw;
         if self.moving() {
             self.bricks
-                .record_filter(ctx, cmd, &sets, counters, self.depth);
+                .record_filter(ctx, cmd, timer, &sets, counters, self.depth);
         } else {
             let updates = self.pools.updates.raw;
             self.bricks
-                .record_update(ctx, cmd, &sets, updates, self.depth);
+                .record_update(ctx, cmd, timer, &sets, updates, self.depth);
         }
         // Empty lists for the next voxel shading (after a full filter, also the change
         // bits voxel shading gave).
@@ -1331,10 +1333,19 @@ impl SvoGi {
     /// Filters every node, whatever the update lists hold, and waits.
     fn full_filter(&self, frame_set: vk::DescriptorSet, set: vk::DescriptorSet) -> Result<()> {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, set)];
+        // Outlives the command buffer, which writes its queries.
+        let mut timer = GpuTimer::new(&self.ctx)?;
         OneShot::new(&self.ctx)?.run("full svo filter", |cmd| {
             compute_to_compute(&self.ctx, cmd);
-            self.bricks
-                .record_filter(&self.ctx, cmd, &sets, self.counters.raw, self.depth);
+            timer.reset(cmd);
+            self.bricks.record_filter(
+                &self.ctx,
+                cmd,
+                &mut timer,
+                &sets,
+                self.counters.raw,
+                self.depth,
+            );
             Ok(())
         })
     }

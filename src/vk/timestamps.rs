@@ -8,7 +8,7 @@ use ash::vk;
 use super::Context;
 
 /// Passes one frame may time.
-const MAX_PASSES: u32 = 64;
+const MAX_PASSES: u32 = 512;
 /// Each pass writes a begin and an end timestamp, each followed by a throw-away one.
 const QUERIES_PER_PASS: u32 = 4;
 
