@@ -450,6 +450,10 @@ gpu_layout! {
         uint list,
         /// Unused.
         uint pad2,
+        /// `mark.comp`: the first voxel (xyz) of the region where moving meshes were or are.
+        ivec4 region_min,
+        /// `mark.comp`: the last voxel (xyz) of that region (below `region_min`: none).
+        ivec4 region_max,
     }
 
     /// Push constants of every mesh draw.

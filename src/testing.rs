@@ -80,23 +80,37 @@ pub fn render_frames_with(
 }
 
 /// The Cornell box at `cornell` with a cube flying across it (x oscillating by 0.6 over 4
-/// seconds), written into `dir`.
-pub fn moving_cube_scene(cornell: &std::path::Path, dir: &std::path::Path) -> Scene {
+/// seconds), written into `dir`. With `glow` the cube is the only light (emitting
+/// radiance 4) and the box's own light is off.
+pub fn moving_cube_scene(cornell: &std::path::Path, dir: &std::path::Path, glow: bool) -> Scene {
     std::fs::create_dir_all(dir).unwrap();
+    let material = if glow {
+        std::fs::write(
+            dir.join("cube.mtl"),
+            "newmtl glow\nKd 0.5 0.5 0.5\nKe 4 4 4\n",
+        )
+        .unwrap();
+        "mtllib cube.mtl\nusemtl glow\n"
+    } else {
+        ""
+    };
     std::fs::write(
         dir.join("cube.obj"),
-        "v -0.15 0.3 -0.15\nv 0.15 0.3 -0.15\nv 0.15 0.6 -0.15\nv -0.15 0.6 -0.15\n\
-        v -0.15 0.3 0.15\nv 0.15 0.3 0.15\nv 0.15 0.6 0.15\nv -0.15 0.6 0.15\n\
-        f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n",
+        format!(
+            "{material}v -0.15 0.3 -0.15\nv 0.15 0.3 -0.15\nv 0.15 0.6 -0.15\nv -0.15 0.6 -0.15\n\
+             v -0.15 0.3 0.15\nv 0.15 0.3 0.15\nv 0.15 0.6 0.15\nv -0.15 0.6 0.15\n\
+             f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n"
+        ),
     )
     .unwrap();
     let scene_file = dir.join("moving.toml");
     std::fs::write(
         &scene_file,
         format!(
-            "[[mesh]]\npath = {:?}\n[[mesh]]\npath = \"cube.obj\"\n\
+            "[[mesh]]\npath = {:?}\nemission_scale = {}\n[[mesh]]\npath = \"cube.obj\"\n\
              animate = {{ kind = \"oscillate\", axis = [1, 0, 0], amplitude = 0.6, period_s = 4 }}\n",
-            cornell.to_string_lossy()
+            cornell.to_string_lossy(),
+            if glow { 0.0 } else { 1.0 }
         ),
     )
     .unwrap();

@@ -28,7 +28,7 @@ use glam::Vec3;
 use crate::gbuffer::GBuffer;
 use crate::gpu_layout::{self as layout, GiUniforms};
 use crate::renderer::GiSettings;
-use crate::scene::Scene;
+use crate::scene::{Aabb, Scene};
 use crate::scene_gpu::SceneDraw;
 use crate::svo::{Capacities, SvoGi};
 use crate::vk::{
@@ -62,6 +62,22 @@ impl Grid {
             voxel_size: size / resolution as f32,
             resolution,
         }
+    }
+
+    /// The voxels (first and last, each axis) that `bounds` touches, one more around
+    /// (conservative voxelization dilates triangles by up to a voxel); `None` for empty
+    /// bounds.
+    pub fn voxels_of(&self, bounds: &Aabb) -> Option<[[i32; 3]; 2]> {
+        if bounds.is_empty() {
+            return None;
+        }
+        let voxel = |p: Vec3, extra: f32| {
+            let v = ((p - self.origin) / self.voxel_size).floor() + Vec3::splat(extra);
+            v.clamp(Vec3::splat(-2.0), Vec3::splat(self.resolution as f32 + 1.0))
+                .as_ivec3()
+                .to_array()
+        };
+        Some([voxel(bounds.min, -1.0), voxel(bounds.max, 1.0)])
     }
 }
 
@@ -439,7 +455,7 @@ impl Dense {
         layouts: [vk::DescriptorSetLayout; 3],
         linear: vk::Sampler,
     ) -> Result<Self> {
-        let moving_meshes = scene.meshes.iter().any(|m| m.animation.is_some());
+        let moving_meshes = scene.has_moving_meshes();
         let volumes = Volumes::new(ctx, resolution, moving_meshes && !full_update)?;
         SetWriter::new(ctx, set)
             .storage_image(layout::BINDING_GI_ALBEDO, volumes.albedo.view)

@@ -155,7 +155,7 @@ fn moving_mesh_leaves_no_voxels_behind() {
         return;
     };
     let dir = std::env::temp_dir().join(format!("voxcone-moving-{}", std::process::id()));
-    let scene = moving_cube_scene(&cornell, &dir);
+    let scene = moving_cube_scene(&cornell, &dir, false);
     let times = [0.0, 0.5, 1.0];
     let (ctx, moved) = render_at(scene.clone(), 32, &times, false);
     let moved_voxels = occupancy(&moved);

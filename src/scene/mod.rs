@@ -269,6 +269,24 @@ impl Scene {
         l
     }
 
+    /// Whether some mesh moves (lights may orbit without it).
+    pub fn has_moving_meshes(&self) -> bool {
+        self.meshes.iter().any(|m| m.animation.is_some())
+    }
+
+    /// World bounds of the moving meshes at time `time_s` (empty without any).
+    pub fn moving_bounds(&self, time_s: f32) -> Aabb {
+        (0..self.meshes.len())
+            .filter(|&i| self.meshes[i].animation.is_some())
+            .fold(Aabb::EMPTY, |b, i| {
+                b.union(
+                    &self.meshes[i]
+                        .local_bounds
+                        .transformed(self.mesh_transform(i, time_s)),
+                )
+            })
+    }
+
     pub fn is_animated(&self) -> bool {
         self.meshes.iter().any(|m| m.animation.is_some())
             || self.lights.iter().any(|l| l.orbit.is_some())

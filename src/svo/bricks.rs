@@ -90,6 +90,7 @@ pub struct BrickPasses {
     filter: Pipeline,
     apron: Pipeline,
     spread: Pipeline,
+    mark: Pipeline,
 }
 
 impl BrickPasses {
@@ -104,6 +105,7 @@ impl BrickPasses {
             filter: pipeline("svo filter", s::SVO_BRICKS_FILTER_COMP)?,
             apron: pipeline("svo apron", s::SVO_BRICKS_APRON_COMP)?,
             spread: pipeline("svo spread", s::SVO_BRICKS_SPREAD_COMP)?,
+            mark: pipeline("svo mark", s::SVO_BRICKS_MARK_COMP)?,
         })
     }
 
@@ -156,16 +158,36 @@ impl BrickPasses {
     /// Filters only what changed, bottom-up from the leaves that voxel shading put on
     /// the changed list of their level: per level, the changed nodes put themselves and
     /// their 26 neighbours on the level's border list and their parents on the changed
-    /// list above; the border list gets its borders, the changed parents are filtered.
+    /// list above, which the nodes near `region` (voxels of the effective grid, first and
+    /// last, where moving meshes were or are) join; the border list gets its borders, the
+    /// changed parents are filtered.
+    #[allow(clippy::too_many_arguments)]
     pub fn record_update(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         timer: &mut GpuTimer,
         sets: &[(u32, vk::DescriptorSet)],
-        updates: vk::Buffer,
+        (counters, updates): (vk::Buffer, vk::Buffer),
         depth: u32,
+        region: Option<[[i32; 3]; 2]>,
     ) {
+        let mark = |level: u32| {
+            let Some([first, last]) = region else {
+                return;
+            };
+            let push = SvoPush {
+                level,
+                over: layout::SVO_OVER_LEVEL,
+                region_min: [first[0], first[1], first[2], 0],
+                region_max: [last[0], last[1], last[2], 0],
+                ..Default::default()
+            };
+            self.mark.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
+            let offset = super::octree::level_offset(level);
+            self.mark.dispatch_indirect(cmd, sets, counters, offset);
+            compute_to_indirect(ctx, cmd);
+        };
         for level in (0..depth).rev() {
             let changed = level & 1;
             let border = 2 + changed;
@@ -176,8 +198,14 @@ impl BrickPasses {
             };
             timer.begin(cmd, &format!("spread {level}"));
             reset_update_lists(ctx, cmd, updates, filled);
+            if level + 1 == depth {
+                mark(level);
+            }
             dispatch_for_list(&self.spread, cmd, sets, level, updates, changed);
             compute_to_indirect(ctx, cmd);
+            if level > 0 {
+                mark(level - 1);
+            }
             timer.end(cmd);
             timer.begin(cmd, &format!("border {level}"));
             dispatch_for_list(&self.apron, cmd, sets, level, updates, border);

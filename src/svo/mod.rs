@@ -21,7 +21,7 @@ use gpu_allocator::MemoryLocation;
 use crate::gi::voxelize::{Meshes, VoxelizePass};
 use crate::gi::{compute_to_compute, reset_voxel_list, Grid};
 use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel, SvoUpdateList, VoxelListHeader};
-use crate::scene::Scene;
+use crate::scene::{Aabb, Scene};
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
     clear_to_zero, copies_to_host_barrier, stage_barrier, update_buffer, Binding, Buffer, Context,
@@ -626,6 +626,13 @@ pub struct SvoGi {
     moving: bool,
     /// What a frame starts from: the static part (the root alone with `--full-update`).
     statics: StaticPart,
+    /// Where the moving meshes were in the last frame.
+    moved: Aabb,
+    /// Voxels (first, last) of the region where moving meshes were last frame or are
+    /// now, whose nodes the filter takes as changed.
+    region: Option<[[i32; 3]; 2]>,
+    /// The next filter runs over every node (the first after a build).
+    filter_all: std::cell::Cell<bool>,
     /// `--full-update`: every mesh is voxelized again every frame too.
     full_update: bool,
     /// The carry table the current frame writes.
@@ -677,7 +684,7 @@ impl SvoGi {
             .apply();
         let fragments = Fragments::new(ctx, capacities.fragments)?;
         fragments.write_set(ctx, set);
-        let pools = Pools::new(ctx, capacities, scene.is_animated() || full_update)?;
+        let pools = Pools::new(ctx, capacities, scene.has_moving_meshes() || full_update)?;
         pools.write_set(ctx, set, linear);
         Ok(Self {
             grid,
@@ -695,7 +702,10 @@ impl SvoGi {
             bricks: bricks::BrickPasses::new(ctx, layouts)?,
             report: None,
             statics: StaticPart::root(),
-            moving: scene.is_animated(),
+            moved: Aabb::EMPTY,
+            region: None,
+            filter_all: std::cell::Cell::new(true),
+            moving: scene.has_moving_meshes(),
             full_update,
             carry_parity: 0,
             frame_counters: (0..frames_in_flight)
@@ -727,11 +737,10 @@ impl SvoGi {
     }
 
     /// Filters the leaf radiance up the tree, bottom-up, with the bricks' borders copied
-    /// from their neighbours at every level (after voxel shading or a bounce). Around
-    /// moving meshes every node is filtered (a node whose subtree lost a moving mesh's
-    /// nodes must be too, and nothing lists it); otherwise only the nodes on the update
-    /// lists, which start from the leaves whose radiance voxel shading changed
-    /// (Dřínovský 2013, 5.5).
+    /// from their neighbours at every level (after voxel shading or a bounce): only the
+    /// nodes on the update lists (Dřínovský 2013, 5.5), which start from the leaves whose
+    /// radiance voxel shading changed and, around moving meshes, the nodes near where
+    /// they were or are; every node after a build and with `--full-update`.
     /// Each level's passes are timed apart: `spread L`, `border L` and `filter L`.
     pub fn record_filter(
         &self,
@@ -743,17 +752,18 @@ impl SvoGi {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, set)];
         let ctx = &self.ctx;
         let counters = self.counters.raw;
-        if self.moving() {
+        let all = self.full_update || self.filter_all.replace(false);
+        if all {
             self.bricks
                 .record_filter(ctx, cmd, timer, &sets, counters, self.depth);
         } else {
-            let updates = self.pools.updates.raw;
+            let buffers = (counters, self.pools.updates.raw);
             self.bricks
-                .record_update(ctx, cmd, timer, &sets, updates, self.depth);
+                .record_update(ctx, cmd, timer, &sets, buffers, self.depth, self.region);
         }
         // Empty lists for the next voxel shading (after a full filter, also the change
         // bits voxel shading gave).
-        if self.moving() {
+        if all {
             stage_barrier(
                 ctx,
                 cmd,
@@ -872,6 +882,8 @@ impl SvoGi {
             }
         }
         let (counters, levels) = built.context("the octree phase did not run")?;
+        self.filter_all.set(true);
+        self.moved = draw.scene.moving_bounds(draw.time_s);
         // Nothing carried yet.
         let carry = self.pools.carry.raw;
         OneShot::new(&self.ctx)?.run("clear svo carry", |cmd| {
@@ -1014,6 +1026,9 @@ impl SvoGi {
             self.build(draw, set)?;
         }
         self.carry_parity ^= 1;
+        let now = draw.scene.moving_bounds(draw.time_s);
+        self.region = self.grid.voxels_of(&now.union(&self.moved));
+        self.moved = now;
         let ctx = &self.ctx;
         // The carry table this frame writes; the other holds what last frame gathered.
         let half = 16 * u64::from(self.pools.carry_capacity);
