@@ -211,6 +211,10 @@ pub struct BenchArgs {
     /// tenth of the scene's size across, once every 60 frames.
     #[arg(long)]
     pub move_light: bool,
+    /// Advance the scene's clock by 1/30 s every frame from `--time` (moving meshes and
+    /// orbiting lights move as in the viewer) instead of rendering every frame at `--time`.
+    #[arg(long)]
+    pub animate: bool,
 }
 
 #[derive(Args, Debug)]

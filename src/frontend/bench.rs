@@ -100,7 +100,12 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
         }
         let start = Instant::now();
         let frame = renderer.begin_frame()?;
-        renderer.record_frame(&frame, args.common.time, &target)?;
+        let time = if args.animate {
+            args.common.time + index as f32 / 30.0
+        } else {
+            args.common.time
+        };
+        renderer.record_frame(&frame, time, &target)?;
         renderer.submit(frame, None, None)?;
         // Waiting for each frame keeps frames from overlapping, so pass times are clean.
         renderer.finish()?;
