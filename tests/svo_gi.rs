@@ -32,8 +32,10 @@ fn svo_agrees_with_dense_grid() {
         "LDR-FLIP svo vs dense {between:.4}; against cornell_point: svo {flip_svo:.4}, \
          dense {flip_dense:.4}"
     );
-    // Measured 0.0087; 0.1322 and 0.1324.
-    assert!(between <= 0.03, "svo and dense differ: LDR-FLIP {between}");
+    // Measured 0.0019 (0.0087 before the octree read neighbouring bricks half a voxel
+    // outside a node, as the dense sampler does; the issue asks for 0.03); 0.1325 and
+    // 0.1324.
+    assert!(between <= 0.005, "svo and dense differ: LDR-FLIP {between}");
     assert!(
         flip_svo <= flip_dense + 0.005,
         "svo {flip_svo} worse than dense {flip_dense}"

@@ -2,8 +2,8 @@
 // six directional levels above it, from the dense grid's 3D textures or, with
 // VOXELS_SVO, from the octree's bricks (Dřínovský 2013, 5.6). Both give the same values:
 // a brick holds its node's 2x2x2 voxels, at voxel centres as in the dense grid, with a
-// border copied from the neighbours, so trilinear filtering inside a node reads what the
-// dense texture would.
+// border copied from the neighbours, so trilinear filtering inside a node, or up to half
+// a voxel outside it, reads what the dense texture would.
 #ifndef SAMPLING_GLSL
 #define SAMPLING_GLSL
 #include "gi/voxels.glsl"
@@ -46,16 +46,48 @@ struct BrickSample {
 };
 
 // The brick of the node at `level` whose cube holds `uvw` (clamped to the grid, as the
-// dense sampler clamps to its edge); false where the octree is empty there: the descent
-// stops at the first missing node, skipping the empty space below it.
+// dense sampler clamps to its edge), and where `uvw` lies in it; false where trilinear
+// filtering there reads only empty voxels. Where the node is missing or empty but the
+// 2x2x2 voxels the dense sampler would blend reach into a neighbouring node, that node's
+// brick is read instead: its border holds those voxels (zero where empty). Inside a
+// large empty cube the descent stops at its top and nothing more is looked up.
 bool locate(vec3 uvw, uint level, out BrickSample s) {
     float voxels = float(2u << level);
     vec3 q = clamp(uvw, 0.0, 1.0) * voxels;
     uvec3 node_coords = min(uvec3(q * 0.5), uvec3((1u << level) - 1u));
-    uint node = find_node(node_coords << (svo_depth() - level), level);
+    uint empty;
+    uint node = find_node_or_gap(node_coords << (svo_depth() - level), level, empty);
     s.brick = node == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[node];
     s.local = q - vec3(node_coords * 2u);
-    return s.brick != SVO_NO_BRICK;
+    if (s.brick != SVO_NO_BRICK) {
+        return true;
+    }
+    ivec3 last = ivec3(int(2u << level) - 1);
+    ivec3 lo = clamp(ivec3(floor(q - 0.5)), ivec3(0), last);
+    ivec3 hi = min(lo + 1, last);
+    // The empty cube around q, in voxels of this level.
+    int size = 2 << (level - empty);
+    ivec3 start = (ivec3(node_coords) >> (level - empty)) * size;
+    if (all(greaterThanEqual(lo, start)) && all(lessThan(hi, start + size))) {
+        return false;
+    }
+    ivec3 first = lo >> 1;
+    ivec3 span = (hi >> 1) - first;
+    for (int i = 0; i < 8; i++) {
+        ivec3 step = ivec3(i & 1, (i >> 1) & 1, i >> 2);
+        ivec3 c = first + step;
+        if (any(greaterThan(step, span)) || all(equal(c, ivec3(node_coords)))) {
+            continue;
+        }
+        uint n = find_node(uvec3(c) << (svo_depth() - level), level);
+        uint brick = n == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[n];
+        if (brick != SVO_NO_BRICK) {
+            s.brick = brick;
+            s.local = q - vec3(c * 2);
+            return true;
+        }
+    }
+    return false;
 }
 
 // Leaf radiance, trilinear, at a located place.

@@ -69,17 +69,25 @@ uint child_octant(uvec3 v, uint level) {
 }
 
 // The node at `level` whose cube holds voxel `v` of the effective grid, or SVO_NO_NODE
-// where the octree has no node there (empty space above it).
-uint find_node(uvec3 v, uint level) {
+// where the octree has no node there; `empty` is then the level of the childless node
+// where the descent stopped, whose whole cube is empty.
+uint find_node_or_gap(uvec3 v, uint level, out uint empty) {
     uint node = 0u;
     for (uint l = 0u; l < level; l++) {
         uint tile = node_children[node] & SVO_CHILD_MASK;
         if (tile == 0u) {
+            empty = l;
             return SVO_NO_NODE;
         }
         node = tile + child_octant(v, l);
     }
+    empty = level;
     return node;
+}
+
+uint find_node(uvec3 v, uint level) {
+    uint empty;
+    return find_node_or_gap(v, level, empty);
 }
 
 // Which of its leaf's 8 voxels voxel v is (x | y << 1 | z << 2).
