@@ -126,7 +126,7 @@ gpu_layout! {
         BINDING_SVO_STATIC_NODES = 30;
         /// SVO passes (set 2): per brick (the leaf bricks', then the interior bricks'), `SVO_CHANGED` and `SVO_BORDER` bits while the filter's update lists are built, `uint[]` storage buffer.
         BINDING_SVO_CHANGES = 31;
-        /// SVO passes (set 2): the filter's update lists (Dřínovský 2013, 5.5): `SvoUpdateList[SVO_UPDATE_LISTS]`, then each list's nodes (`SvoCounters.update_capacity` each), `uint[]` storage buffer.
+        /// SVO passes (set 2): the filter's update lists (Dřínovský 2013, 5.5): `SvoUpdateList[SVO_UPDATE_LISTS]`, `SvoBounceDispatch`, then each list's nodes (`SvoCounters.update_capacity` each), `uint[]` storage buffer.
         BINDING_SVO_UPDATES = 32;
         /// Update lists: nodes whose radiance changed, at levels of even and odd parity (0, 1), and nodes whose border must be copied again (2, 3).
         SVO_UPDATE_LISTS = 4;
@@ -438,6 +438,18 @@ gpu_layout! {
         uint pad1,
         /// Unused.
         uint pad2,
+    }
+
+    /// The bounce's dispatch in a static octree, after the update lists' heads: the voxel list's while anything changed since the last bounce, none once the bounces have converged.
+    struct SvoBounceDispatch {
+        /// Indirect dispatch: the voxel list's workgroups, or 0.
+        uint groups_x,
+        /// Indirect dispatch: 1.
+        uint groups_y,
+        /// Indirect dispatch: 1.
+        uint groups_z,
+        /// 1: a node's radiance or a voxel's direct light changed since the last bounce.
+        uint changed,
     }
 
     /// Push constants of the octree passes that work on one level.

@@ -44,6 +44,7 @@ layout(set = SET_PASS, binding = BINDING_SVO_CHANGES, std430) buffer ChangesBloc
 };
 layout(set = SET_PASS, binding = BINDING_SVO_UPDATES, std430) buffer UpdatesBlock {
     SvoUpdateList update_lists[SVO_UPDATE_LISTS];
+    SvoBounceDispatch bounce_dispatch;
     uint update_nodes[];
 };
 
@@ -158,6 +159,7 @@ void mark_node(uint node, uint brick, uint level, uint bit, uint list) {
     if ((atomicOr(brick_changes[change_slot(brick, level)], bit) & bit) != 0u) {
         return;
     }
+    bounce_dispatch.changed = 1u;
     uint i = atomicAdd(update_lists[list].count, 1u);
     if (i >= counters.update_capacity) {
         return;

@@ -58,15 +58,16 @@ impl InjectPass {
     }
 
     /// One more bounce: direct + albedo x gathered filtered radiance, into the radiance,
-    /// for every voxel of the occupied-voxel list (`list`, which holds the dispatch).
+    /// for the voxels of the occupied-voxel list, dispatched from `(buffer, offset)`: the
+    /// list's head, or a static octree's bounce dispatch (none once converged).
     pub fn record_bounce(
         &self,
         cmd: vk::CommandBuffer,
         frame_set: vk::DescriptorSet,
         gi_set: vk::DescriptorSet,
-        list: vk::Buffer,
+        (buffer, offset): (vk::Buffer, vk::DeviceSize),
     ) {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
-        self.bounce.dispatch_indirect(cmd, &sets, list, 0);
+        self.bounce.dispatch_indirect(cmd, &sets, buffer, offset);
     }
 }

@@ -968,7 +968,12 @@ impl VoxelGi {
         for _ in 0..bounces {
             timer.begin(cmd, "bounce");
             compute_to_compute(ctx, cmd);
-            self.inject.record_bounce(cmd, draw.frame_set, set, list);
+            let dispatch = match &self.voxels {
+                Voxels::Dense(_) => (list, 0),
+                Voxels::Octree(svo) => svo.record_bounce_dispatch(cmd, draw.frame_set, set),
+            };
+            self.inject
+                .record_bounce(cmd, draw.frame_set, set, dispatch);
             timer.end(cmd);
             filter(&self.voxels, timer, "bounce filter");
         }

@@ -25,12 +25,12 @@ use gpu_allocator::MemoryLocation;
 
 use crate::gi::voxelize::{Meshes, VoxelizePass};
 use crate::gi::{compute_to_compute, reset_voxel_list, Grid};
-use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel};
+use crate::gpu_layout::{self as layout, SvoBounceDispatch, SvoCounters, SvoLevel};
 use crate::scene::{Aabb, Scene};
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
     clear_to_zero, copies_to_host_barrier, stage_barrier, update_buffer, Binding, Buffer, Context,
-    GpuTimer, ImageUse, OneShot, SetWriter,
+    GpuTimer, ImageUse, OneShot, Pipeline, SetWriter,
 };
 use octree::Over;
 pub use pools::Capacities;
@@ -164,6 +164,8 @@ pub struct SvoGi {
     voxelize: VoxelizePass,
     octree: octree::OctreePasses,
     bricks: bricks::BrickPasses,
+    /// `bounce_dispatch.comp`: whether a static octree's bounce runs.
+    bounce_gate: Pipeline,
     report: Option<BuildReport>,
     /// The scene has moving meshes: every frame lists their fragments after the static
     /// ones and inserts them into the static part of the octree.
@@ -244,6 +246,13 @@ impl SvoGi {
             )?,
             octree: octree::OctreePasses::new(ctx, layouts)?,
             bricks: bricks::BrickPasses::new(ctx, layouts)?,
+            bounce_gate: Pipeline::compute(
+                ctx,
+                "svo bounce dispatch",
+                crate::vk::shaders::SVO_BRICKS_BOUNCE_DISPATCH_COMP,
+                &layouts,
+                0,
+            )?,
             report: None,
             statics: StaticPart::root(),
             moved: Aabb::EMPTY,
@@ -278,6 +287,25 @@ impl SvoGi {
     /// The occupied leaf voxels: the indirect dispatch of voxel shading and bounces.
     pub fn voxel_list(&self) -> vk::Buffer {
         self.pools.voxel_list.raw
+    }
+
+    /// Records what a bounce dispatches, and returns where (buffer, offset): the voxel
+    /// list around moving meshes; in a static octree the list while anything changed
+    /// since the last bounce and nothing once the bounces have converged (the same light
+    /// would be stored again).
+    pub fn record_bounce_dispatch(
+        &self,
+        cmd: vk::CommandBuffer,
+        frame_set: vk::DescriptorSet,
+        set: vk::DescriptorSet,
+    ) -> (vk::Buffer, vk::DeviceSize) {
+        if self.moving() {
+            return (self.pools.voxel_list.raw, 0);
+        }
+        let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, set)];
+        self.bounce_gate.dispatch(cmd, &sets, [1, 1, 1]);
+        octree::compute_to_indirect(&self.ctx, cmd);
+        (self.pools.updates.raw, pools::BOUNCE_DISPATCH_OFFSET)
     }
 
     /// Filters the leaf radiance up the tree, bottom-up, with the bricks' borders copied
@@ -691,6 +719,21 @@ impl SvoGi {
         if !part.saved {
             let all: Vec<u32> = (0..layout::SVO_UPDATE_LISTS).collect();
             bricks::reset_update_lists(ctx, cmd, p.updates.raw, &all);
+            // The first bounce after a build runs.
+            let first = SvoBounceDispatch {
+                groups_y: 1,
+                groups_z: 1,
+                changed: 1,
+                ..Default::default()
+            };
+            update_buffer(
+                ctx,
+                cmd,
+                p.updates.raw,
+                pools::BOUNCE_DISPATCH_OFFSET,
+                bytemuck::bytes_of(&first),
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+            );
         }
     }
 

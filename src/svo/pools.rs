@@ -9,7 +9,9 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use crate::gi::Grid;
-use crate::gpu_layout::{self as layout, SvoCounters, SvoUpdateList, VoxelListHeader};
+use crate::gpu_layout::{
+    self as layout, SvoBounceDispatch, SvoCounters, SvoUpdateList, VoxelListHeader,
+};
 use crate::scene::Scene;
 use crate::vk::{Buffer, Context, Image, ImageDesc, ImageUse, SetWriter};
 
@@ -228,6 +230,9 @@ pub(super) struct Pools {
 pub(super) const UPDATE_HEADS_BYTES: u64 =
     layout::SVO_UPDATE_LISTS as u64 * std::mem::size_of::<SvoUpdateList>() as u64;
 
+/// The bounce's dispatch, after the update lists' heads in `Pools::updates`.
+pub(super) const BOUNCE_DISPATCH_OFFSET: u64 = UPDATE_HEADS_BYTES;
+
 impl Pools {
     /// `moving`: moving meshes are inserted into the octree every frame; the static
     /// part is kept aside, and the voxels' gathered light is carried from one frame to
@@ -349,7 +354,9 @@ impl Pools {
             )?,
             updates: buffer(
                 "svo update lists",
-                UPDATE_HEADS_BYTES + 4 * u64::from(layout::SVO_UPDATE_LISTS) * nodes,
+                UPDATE_HEADS_BYTES
+                    + std::mem::size_of::<SvoBounceDispatch>() as u64
+                    + 4 * u64::from(layout::SVO_UPDATE_LISTS) * nodes,
                 vk::BufferUsageFlags::INDIRECT_BUFFER,
             )?,
         })

@@ -954,3 +954,44 @@ fn update_lists_follow_moving_meshes() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// In a static scene the bounces stop once they have converged (nothing on the update
+/// lists, no voxel's direct light changed: the same light would be stored again), and a
+/// light that moves starts them again.
+#[test]
+fn bounces_stop_once_converged() {
+    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+        return;
+    };
+    let scene = Scene::load(&path, &LoadOptions::REFERENCE).unwrap();
+    let settings = gi_settings(64, VoxelStructure::Octree { capacities: None }, false);
+    let frames = 40;
+    let mut dispatched = Vec::new();
+    let (ctx, renderer) = render_frames_with(scene, settings, &vec![0.0; frames], |r, i| {
+        if i + 1 == frames {
+            r.scene.lights[0].position.x += 0.05;
+        }
+        if i > 0 {
+            r.finish().unwrap();
+            let svo = r.gi().unwrap().octree().unwrap();
+            let words = svo.download_words(&svo.pools.updates).unwrap();
+            dispatched.push(words[(super::pools::BOUNCE_DISPATCH_OFFSET / 4) as usize]);
+        }
+    });
+    let svo = renderer.gi().unwrap().octree().unwrap();
+    let words = svo.download_words(&svo.pools.updates).unwrap();
+    dispatched.push(words[(super::pools::BOUNCE_DISPATCH_OFFSET / 4) as usize]);
+    eprintln!("bounce workgroups per frame: {dispatched:?}");
+    let converged = dispatched.iter().position(|&g| g == 0);
+    assert!(converged.is_some(), "the bounces never stopped");
+    let still = &dispatched[converged.unwrap()..frames - 2];
+    assert!(
+        still.iter().all(|&g| g == 0),
+        "the bounces started again by themselves"
+    );
+    assert!(
+        *dispatched.last().unwrap() > 0,
+        "the moved light did not start the bounces"
+    );
+    assert_eq!(ctx.validation_messages(), 0);
+}

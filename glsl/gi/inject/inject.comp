@@ -20,7 +20,7 @@ layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform readonly ui
 layout(push_constant) uniform PushBlock {
     InjectPush push;
 };
-layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform writeonly image3D voxel_direct;
+layout(set = SET_PASS, binding = BINDING_GI_DIRECT, rgba16f) uniform image3D voxel_direct;
 
 // Whether voxel v of the grid holds a surface.
 bool voxel_occupied(ivec3 v) {
@@ -104,6 +104,12 @@ void main() {
         imageStore(voxel_normal, voxel, uvec4(pack_rgba8(vec4((lit * 0.5 + 0.5) * 255.0, packed_normal.a))));
     }
     vec4 radiance = vec4(rho / PI * e + emission, 1.0);
+#ifdef VOXELS_SVO
+    // A light that moved: the bounces must run again (svo/bricks/bounce_dispatch.comp).
+    if (radiance_changed(radiance, imageLoad(voxel_direct, voxel))) {
+        bounce_dispatch.changed = 1u;
+    }
+#endif
     imageStore(voxel_direct, voxel, radiance);
 #ifdef VOXELS_SVO
     // An octree rebuilt around moving meshes starts from the light its voxels gathered

@@ -13,11 +13,17 @@ layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform image3D s
 // Above one half-float step (2^-10 relative), so that a converged voxel stays unchanged.
 const float RADIANCE_CHANGE = 1.0 / 512.0;
 
+// Whether `now` differs from `stored` (a half float) by more than the half floats hold:
+// `RADIANCE_CHANGE` relative, and below the smallest normal half float (2^-14), where the
+// store may flush to zero, not at all.
+bool radiance_changed(vec4 now, vec4 stored) {
+    vec4 tolerance = max(max(abs(stored), abs(now)) * RADIANCE_CHANGE, vec4(1.0 / 16384.0));
+    return any(greaterThan(abs(now - stored), tolerance));
+}
+
 void store_radiance(ListedVoxel entry, vec4 radiance) {
 #ifdef VOXELS_SVO
-    vec4 stored = imageLoad(shaded_radiance, entry.radiance_texel);
-    vec4 tolerance = max(abs(stored), abs(radiance)) * RADIANCE_CHANGE;
-    if (all(lessThanEqual(abs(radiance - stored), tolerance))) {
+    if (!radiance_changed(radiance, imageLoad(shaded_radiance, entry.radiance_texel))) {
         return;
     }
     imageStore(shaded_radiance, entry.radiance_texel, radiance);
