@@ -368,9 +368,13 @@ impl CommonArgs {
     }
 }
 
-/// The built-in Cornell box in `assets/`.
+/// The built-in Cornell box in `assets/`: of the checkout `cargo run` runs from, else of
+/// the one the binary was built in (a build shared between checkouts may be either's).
 pub fn default_scene() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/cornell.toml")
+    std::env::var_os("CARGO_MANIFEST_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")))
+        .join("assets/cornell.toml")
 }
 
 #[cfg(test)]
