@@ -81,6 +81,23 @@ impl Grid {
     }
 }
 
+/// Moves new `images` into the layout compute passes write them in, and waits.
+fn to_compute_write(ctx: &Arc<Context>, name: &str, images: &[&Image]) -> Result<()> {
+    OneShot::new(ctx)?.run(name, |cmd| {
+        for image in images {
+            image_barrier(
+                ctx,
+                cmd,
+                image.raw,
+                image.full_range(),
+                ImageUse::UNDEFINED,
+                ImageUse::COMPUTE_WRITE,
+            );
+        }
+        Ok(())
+    })
+}
+
 /// Cone settings.
 #[derive(Clone, Copy, Debug)]
 pub struct ConeSettings {
@@ -477,19 +494,11 @@ impl Dense {
             )
             .apply();
         // The radiance volumes stay in GENERAL: written as storage, sampled by cones.
-        OneShot::new(ctx)?.run("gi volume layouts", |cmd| {
-            for image in [&volumes.radiance, &volumes.direct, &volumes.directional] {
-                image_barrier(
-                    ctx,
-                    cmd,
-                    image.raw,
-                    image.full_range(),
-                    ImageUse::UNDEFINED,
-                    ImageUse::COMPUTE_WRITE,
-                );
-            }
-            Ok(())
-        })?;
+        to_compute_write(
+            ctx,
+            "gi volume layouts",
+            &[&volumes.radiance, &volumes.direct, &volumes.directional],
+        )?;
         let compact = compact::CompactPass::new(ctx, layouts, resolution)?;
         SetWriter::new(ctx, set)
             .buffer(
@@ -837,19 +846,11 @@ impl VoxelGi {
             shadow: low("cone shadow")?,
             specular: low("cone specular")?,
         };
-        OneShot::new(&self.ctx)?.run("reduced-resolution layouts", |cmd| {
-            for image in [&low_res.indirect, &low_res.shadow, &low_res.specular] {
-                image_barrier(
-                    &self.ctx,
-                    cmd,
-                    image.raw,
-                    image.full_range(),
-                    ImageUse::UNDEFINED,
-                    ImageUse::COMPUTE_WRITE,
-                );
-            }
-            Ok(())
-        })?;
+        to_compute_write(
+            &self.ctx,
+            "reduced-resolution layouts",
+            &[&low_res.indirect, &low_res.shadow, &low_res.specular],
+        )?;
         SetWriter::new(&self.ctx, self.set)
             .storage_image(layout::BINDING_GI_INDIRECT, low_res.indirect.view)
             .storage_image(layout::BINDING_GI_SHADOW, low_res.shadow.view)
@@ -896,8 +897,8 @@ impl VoxelGi {
     /// previous frame's filtered radiance, so bounces accumulate over frames at the cost
     /// of one (moving light takes a few frames to settle in the indirect light).
     ///
-    /// With moving meshes the octree is rebuilt every frame and its bricks are assigned
-    /// anew; the light its voxels gathered is carried over by voxel (`crate::svo`), so
+    /// With moving meshes every frame inserts them into the octree's static part, and
+    /// their bricks are assigned anew; the light its voxels gathered is carried over by voxel (`crate::svo`), so
     /// bounces still accumulate one per frame. `slot` is the frame's slot in flight.
     pub fn record_update(
         &mut self,
@@ -915,7 +916,7 @@ impl VoxelGi {
                 dense.record_voxelize(ctx, cmd, timer, draw, set, n);
                 dense.compact.list.raw
             }
-            // Built before the first frame; rebuilt every frame around moving meshes.
+            // Built before the first frame; moving meshes inserted every frame.
             Voxels::Octree(svo) => {
                 if svo.moving() {
                     svo.record_moving(cmd, timer, draw, set, slot)?;

@@ -18,8 +18,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
-use super::octree::{compute_to_indirect, dispatch_for_level, Over};
-use crate::gi::compute_to_compute;
+use super::octree::{compute_to_indirect, dispatch_for_level, timed_pass, Over};
 use crate::gpu_layout::{self as layout, SvoPush, SvoUpdateList};
 use crate::vk::{stage_barrier, Context, GpuTimer, Pipeline};
 
@@ -143,15 +142,13 @@ impl BrickPasses {
     ) {
         for level in (0..depth).rev() {
             if level + 1 < depth {
-                timer.begin(cmd, &format!("filter {level}"));
-                dispatch_for_level(&self.filter, cmd, sets, level, counters, Over::Level);
-                compute_to_compute(ctx, cmd);
-                timer.end(cmd);
+                timed_pass(ctx, cmd, timer, &format!("filter {level}"), || {
+                    dispatch_for_level(&self.filter, cmd, sets, level, counters, Over::Level)
+                });
             }
-            timer.begin(cmd, &format!("border {level}"));
-            dispatch_for_level(&self.apron, cmd, sets, level, counters, Over::Level);
-            compute_to_compute(ctx, cmd);
-            timer.end(cmd);
+            timed_pass(ctx, cmd, timer, &format!("border {level}"), || {
+                dispatch_for_level(&self.apron, cmd, sets, level, counters, Over::Level)
+            });
         }
     }
 
@@ -207,15 +204,13 @@ impl BrickPasses {
                 mark(level - 1);
             }
             timer.end(cmd);
-            timer.begin(cmd, &format!("border {level}"));
-            dispatch_for_list(&self.apron, cmd, sets, level, updates, border);
-            compute_to_compute(ctx, cmd);
-            timer.end(cmd);
+            timed_pass(ctx, cmd, timer, &format!("border {level}"), || {
+                dispatch_for_list(&self.apron, cmd, sets, level, updates, border)
+            });
             if level > 0 {
-                timer.begin(cmd, &format!("filter {}", level - 1));
-                dispatch_for_list(&self.filter, cmd, sets, level - 1, updates, changed ^ 1);
-                compute_to_compute(ctx, cmd);
-                timer.end(cmd);
+                timed_pass(ctx, cmd, timer, &format!("filter {}", level - 1), || {
+                    dispatch_for_list(&self.filter, cmd, sets, level - 1, updates, changed ^ 1)
+                });
             }
         }
     }

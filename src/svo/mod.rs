@@ -279,7 +279,8 @@ impl SvoGi {
         })
     }
 
-    /// Whether the octree is rebuilt every frame (moving meshes, or `--full-update`).
+    /// Whether every frame inserts meshes into the octree: the moving meshes into the
+    /// static part, or with `--full-update` every mesh into the bare root.
     pub fn moving(&self) -> bool {
         self.moving || self.full_update
     }

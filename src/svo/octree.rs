@@ -62,6 +62,21 @@ pub fn dispatch_for_level(
     pipeline.dispatch_indirect(cmd, sets, counters, offset);
 }
 
+/// Records `pass` as GPU pass `name`: timed, and followed by a barrier to the next
+/// compute pass.
+pub fn timed_pass(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    timer: &mut GpuTimer,
+    name: &str,
+    pass: impl FnOnce(),
+) {
+    timer.begin(cmd, name);
+    pass();
+    compute_to_compute(ctx, cmd);
+    timer.end(cmd);
+}
+
 pub struct OctreePasses {
     flag: Pipeline,
     alloc: Pipeline,
@@ -122,15 +137,12 @@ impl OctreePasses {
         neighbours: Over,
     ) {
         for level in 0..depth {
-            timer.begin(cmd, &format!("flag {level}"));
-            dispatch_for_level(&self.flag, cmd, sets, level, counters, Over::Fragments);
-            compute_to_compute(ctx, cmd);
-            timer.end(cmd);
-
-            timer.begin(cmd, &format!("alloc {level}"));
-            dispatch_for_level(&self.alloc, cmd, sets, level, counters, Over::Level);
-            compute_to_compute(ctx, cmd);
-            timer.end(cmd);
+            timed_pass(ctx, cmd, timer, &format!("flag {level}"), || {
+                dispatch_for_level(&self.flag, cmd, sets, level, counters, Over::Fragments)
+            });
+            timed_pass(ctx, cmd, timer, &format!("alloc {level}"), || {
+                dispatch_for_level(&self.alloc, cmd, sets, level, counters, Over::Level)
+            });
 
             if level + 1 < depth {
                 let child = level + 1;

@@ -210,7 +210,7 @@ pub(super) struct Pools {
     /// Per leaf voxel, its fragments' attribute sums and count (`SVO_SUM_WORDS` words).
     pub(super) sums: Buffer,
     /// Two tables of `carry_capacity` entries: the light each leaf voxel gathered, kept
-    /// across rebuilds of the octree (only when it is rebuilt every frame).
+    /// across frames that insert meshes into the octree (only then: their bricks change).
     pub(super) carry: Buffer,
     pub(super) carry_capacity: u32,
     /// The static part's child entries and bricks as its build left them (only with

@@ -331,6 +331,12 @@ fn cornell() -> Option<Scene> {
     Some(Scene::load(&path, &LoadOptions::default()).unwrap())
 }
 
+/// The Cornell box of the point-light reference, as the reference renders it.
+fn cornell_point() -> Option<Scene> {
+    let path = shared_file("reference/cornell_point.scene.json")?;
+    Some(Scene::load(&path, &LoadOptions::REFERENCE).unwrap())
+}
+
 #[test]
 fn octree_matches_cpu_octree_on_cornell_box() {
     let Some(scene) = cornell() else { return };
@@ -526,11 +532,10 @@ fn brick_voxels(
 /// octree is empty, the edge voxel repeated at the grid's edge).
 #[test]
 fn bricks_filter_and_borders_match_cpu() {
-    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+    let Some(scene) = cornell_point() else {
         return;
     };
     let depth = 6;
-    let scene = Scene::load(&path, &LoadOptions::REFERENCE).unwrap();
     let (ctx, renderer) = build_and_render(scene, depth, None, 1);
     let svo = renderer.gi().unwrap().octree().unwrap();
     let d = download(svo);
@@ -788,10 +793,9 @@ fn moving_mesh_leaves_no_nodes_behind() {
 /// octree as the build that keeps it.
 #[test]
 fn full_update_rebuilds_the_same_octree() {
-    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+    let Some(scene) = cornell_point() else {
         return;
     };
-    let scene = Scene::load(&path, &LoadOptions::REFERENCE).unwrap();
     let structure = VoxelStructure::Octree { capacities: None };
     let (ctx, full) = render_frames(scene.clone(), gi_settings(64, structure, true), &[0.0, 0.5]);
     let (_, kept) = render_frames(scene, gi_settings(64, structure, false), &[0.0, 0.5]);
@@ -802,8 +806,8 @@ fn full_update_rebuilds_the_same_octree() {
     assert_eq!(ctx.validation_messages(), 0);
 }
 
-/// Around moving meshes the octree is rebuilt every frame with new bricks, and the light
-/// each voxel gathered is carried over by voxel: frames at a fixed time add one bounce
+/// Around moving meshes every frame gives their nodes (and the static leaves they reach)
+/// new bricks, and the light each voxel gathered is carried over by voxel: frames at a fixed time add one bounce
 /// each and converge to what one frame with every bounce gives.
 #[test]
 fn carried_light_converges_to_all_bounces() {
@@ -915,10 +919,9 @@ fn check_update_lists(
 /// The first frames add bounces too.
 #[test]
 fn update_lists_filter_what_changed() {
-    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+    let Some(scene) = cornell_point() else {
         return;
     };
-    let scene = Scene::load(&path, &LoadOptions::REFERENCE).unwrap();
     for still in [0, 3] {
         let moved = |renderer: &mut Renderer, i: usize| {
             if i < 6 - still {
@@ -960,10 +963,9 @@ fn update_lists_follow_moving_meshes() {
 /// light that moves starts them again.
 #[test]
 fn bounces_stop_once_converged() {
-    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+    let Some(scene) = cornell_point() else {
         return;
     };
-    let scene = Scene::load(&path, &LoadOptions::REFERENCE).unwrap();
     let settings = gi_settings(64, VoxelStructure::Octree { capacities: None }, false);
     let frames = 40;
     let mut dispatched = Vec::new();
