@@ -181,3 +181,14 @@ fn voxel_options_without_voxels() {
         &["--debug-view", "--gi dense"],
     );
 }
+
+#[test]
+fn move_light_without_a_light() {
+    let dir = temp_dir("move_light");
+    write(&dir, "tri.obj", TRIANGLE);
+    let scene = scene_for(&dir, "tri.obj");
+    assert_fails_naming(
+        &["bench", &scene, "--move-light", "--frames", "1"],
+        &["--move-light", "no light"],
+    );
+}

@@ -64,6 +64,9 @@ fn stats(values: &[f64]) -> PassStats {
 pub fn run(args: &BenchArgs) -> Result<BenchReport> {
     let ctx = create_context(&args.common, Vec::new())?;
     let scene = load_scene(&args.common)?;
+    if args.move_light && scene.lights.is_empty() {
+        bail!("--move-light: the scene has no light to move");
+    }
     let triangles = scene.triangle_count;
     let extent = vk::Extent2D {
         width: args.size.0,
@@ -89,9 +92,6 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
     let bounds = renderer.scene.bounds(args.common.time);
     let radius = 0.05 * (bounds.max - bounds.min).length();
     let light_start = renderer.scene.lights.first().map(|l| l.position);
-    if args.move_light && light_start.is_none() {
-        bail!("--move-light: the scene has no light");
-    }
     for index in 0..total_frames {
         if let (true, Some(centre)) = (args.move_light, light_start) {
             let angle = std::f32::consts::TAU * index as f32 / 60.0;
