@@ -72,7 +72,9 @@ gpu_layout! {
         BINDING_GI_INDIRECT = 12;
         /// GI passes (set 2): G-buffer transmittance (r) and index of refraction (g), `rg16f` storage.
         BINDING_GI_GBUFFER_TRANSMISSION = 13;
-        /// GI passes (set 2): soft-shadow cone visibility of lights 0..`CONE_SHADOW_LIGHTS` at reduced resolution, `rgba16f` storage.
+        /// GI passes (set 2): soft-shadow cone visibility of every light at reduced
+        /// resolution, `rgba16f` storage: lights 4k..4k+3 in the channels of the k-th band
+        /// of rows, each band as tall as the reduced-resolution image.
         BINDING_GI_SHADOW = 14;
         /// GI passes (set 2): specular cone radiance (rgb) at reduced resolution, `rgba16f` storage.
         BINDING_GI_SPECULAR = 15;
@@ -84,9 +86,9 @@ gpu_layout! {
         /// GI passes (set 2): G-buffer emission, `rgba16f` storage (the upsample shades the
         /// pixels itself with soft-shadow cones, and the lighting pass does not run).
         BINDING_GI_GBUFFER_EMISSION = 17;
-        /// Lights whose soft-shadow cones are traced at the reduced resolution of the
-        /// indirect light (one channel each); further lights trace theirs per pixel.
-        CONE_SHADOW_LIGHTS = 4;
+        /// GI passes (set 2): refraction cone radiance (rgb) at reduced resolution, and 1 in
+        /// alpha where the traced pixel is transmissive (0 elsewhere), `rgba16f` storage.
+        BINDING_GI_TRANSMITTED = 18;
         /// filter pass (set 2): the base radiance, read by the first level, `rgba16f` storage.
         BINDING_FILTER_BASE = 0;
         /// filter pass (set 2): the directional level read (levels after the first), `rgba16f` storage.

@@ -348,10 +348,12 @@ impl Volumes {
 struct LowRes {
     /// Gathered indirect light (rgb) and ambient occlusion (a).
     indirect: Image,
-    /// Soft-shadow cone visibility of the first `CONE_SHADOW_LIGHTS` lights.
+    /// Soft-shadow cone visibility of every light (`BINDING_GI_SHADOW`).
     shadow: Image,
     /// Specular cone radiance (before Ks).
     specular: Image,
+    /// Refraction cone radiance, and where it was traced.
+    transmitted: Image,
 }
 
 /// The set-2 bindings every GI pass shares.
@@ -383,6 +385,7 @@ fn gi_bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_GI_SHADOW, storage, all),
         Binding::new(layout::BINDING_GI_SPECULAR, storage, all),
         Binding::new(layout::BINDING_GI_GBUFFER_EMISSION, storage, all),
+        Binding::new(layout::BINDING_GI_TRANSMITTED, storage, all),
         Binding::new(
             layout::BINDING_GI_VOXEL_LIST,
             vk::DescriptorType::STORAGE_BUFFER,
@@ -451,6 +454,8 @@ pub struct VoxelGi {
     indirect_scale: u32,
     /// Created with the screen targets.
     low_res: Option<LowRes>,
+    /// The scene's lights, each with a soft-shadow visibility channel at reduced resolution.
+    light_count: u32,
     cone_trace: cone_trace::ConeTracePass,
     voxel_view: debug::VoxelViewPass,
     set: vk::DescriptorSet,
@@ -772,6 +777,7 @@ impl VoxelGi {
             indirect_scale_setting: cones.indirect_scale,
             indirect_scale: 1,
             low_res: None,
+            light_count: scene.lights.len() as u32,
             cone_trace: cone_trace::ConeTracePass::new(ctx, layouts, octree)?,
             voxel_view: debug::VoxelViewPass::new(ctx, layouts, octree)?,
             set,
@@ -829,32 +835,44 @@ impl VoxelGi {
             std::mem::offset_of!(GiUniforms, indirect_scale),
             bytemuck::bytes_of(&self.indirect_scale),
         );
-        let low = |name| {
+        let (width, height) = (
+            extent.width.div_ceil(self.indirect_scale),
+            extent.height.div_ceil(self.indirect_scale),
+        );
+        let low = |name, bands: u32| {
             Image::new(
                 &self.ctx,
                 name,
                 ImageDesc::d2(
                     RADIANCE_FORMAT,
-                    extent.width.div_ceil(self.indirect_scale),
-                    extent.height.div_ceil(self.indirect_scale),
+                    width,
+                    height * bands,
                     vk::ImageUsageFlags::STORAGE,
                 ),
             )
         };
         let low_res = LowRes {
-            indirect: low("indirect")?,
-            shadow: low("cone shadow")?,
-            specular: low("cone specular")?,
+            indirect: low("indirect", 1)?,
+            // One band of rows per four lights.
+            shadow: low("cone shadow", self.light_count.div_ceil(4).max(1))?,
+            specular: low("cone specular", 1)?,
+            transmitted: low("cone transmitted", 1)?,
         };
         to_compute_write(
             &self.ctx,
             "reduced-resolution layouts",
-            &[&low_res.indirect, &low_res.shadow, &low_res.specular],
+            &[
+                &low_res.indirect,
+                &low_res.shadow,
+                &low_res.specular,
+                &low_res.transmitted,
+            ],
         )?;
         SetWriter::new(&self.ctx, self.set)
             .storage_image(layout::BINDING_GI_INDIRECT, low_res.indirect.view)
             .storage_image(layout::BINDING_GI_SHADOW, low_res.shadow.view)
             .storage_image(layout::BINDING_GI_SPECULAR, low_res.specular.view)
+            .storage_image(layout::BINDING_GI_TRANSMITTED, low_res.transmitted.view)
             .storage_image(layout::BINDING_GI_SCREEN, radiance.view)
             .storage_image(layout::BINDING_GI_GBUFFER_ALBEDO, gbuffer.albedo.view)
             .storage_image(layout::BINDING_GI_GBUFFER_NORMAL, gbuffer.normal.view)

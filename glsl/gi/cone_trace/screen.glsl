@@ -14,4 +14,11 @@ ivec2 representative(ivec2 low) {
     ivec2 full = low * int(gi.indirect_scale) + int(gi.indirect_scale) / 2;
     return min(full, ivec2(frame.width, frame.height) - 1);
 }
+
+// Where reduced-resolution pixel `low` keeps the soft-shadow visibility of lights
+// 4 band .. 4 band + 3 (`BINDING_GI_SHADOW`).
+ivec2 shadow_texel(ivec2 low, uint band) {
+    int height = (int(frame.height) + int(gi.indirect_scale) - 1) / int(gi.indirect_scale);
+    return low + ivec2(0, int(band) * height);
+}
 #endif

@@ -7,13 +7,13 @@
 // - indirect specular: the cone along the reflection traced for glossy pixels (Ks > 0)
 //   at reduced resolution, upsampled like the diffuse light, times Ks;
 // - with soft-shadow cones instead of shadow maps, the whole shading: emission and the
-//   direct light (the first lights' visibility upsampled like the indirect light), as the
+//   direct light (each light's cone visibility upsampled like the indirect light), as the
 //   lighting pass does not run then;
 // - ambient occlusion on the indirect terms;
-// - transmission: transmissive pixels (d < 1) pass 1 - d of the light from one cone
-//   along the refracted ray.
+// - transmission: transmissive pixels (d < 1) pass 1 - d of the light from the cone
+//   along the refracted ray, upsampled from the transmissive samples.
 // Each term follows its FLAG_*; the debug views show the indirect light or AO alone.
-#include "gi/cones.glsl"
+// The cones are all traced by the cone_trace pass: this pass marches none.
 #include "common/direct_light.glsl"
 #include "gi/cone_trace/screen.glsl"
 
@@ -23,15 +23,20 @@ layout(set = SET_PASS, binding = BINDING_GI_SHADOW, rgba16f) uniform readonly im
 layout(set = SET_PASS, binding = BINDING_GI_SPECULAR, rgba16f) uniform readonly image2D specular_low;
 layout(set = SET_PASS, binding = BINDING_GI_SCREEN, rgba32f) uniform image2D screen_radiance;
 layout(set = SET_PASS, binding = BINDING_GI_GBUFFER_EMISSION, rgba16f) uniform readonly image2D gbuffer_emission;
+layout(set = SET_PASS, binding = BINDING_GI_TRANSMITTED, rgba16f) uniform readonly image2D transmitted_low;
 
-// The gathered indirect light (rgb) and ambient occlusion (a) at `pixel`, upsampled;
-// with `glossy` also the specular cone's radiance and, with soft-shadow cones, the first
-// lights' visibility (each image is read only where it is needed: on a CPU driver every
-// load counts).
-vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n, bool glossy, out vec4 visibility, out vec3 specular) {
-    bool cones = (frame.flags & FLAG_SHADOW_CONES) != 0u;
-    vec4 visibility_sum = vec4(0.0);
-    vec3 specular_sum = vec3(0.0);
+// The four reduced-resolution samples around a pixel and their upsampling weights.
+struct Taps {
+    ivec2 low[4];
+    float weight[4];
+    float total;
+};
+
+// Each pixel blends the four nearest reduced-resolution samples bilinearly, down-weighting
+// those whose surface lies at another depth or faces another way.
+Taps upsample_taps(ivec2 pixel, vec3 p, vec3 n) {
+    Taps taps;
+    taps.total = 0.0;
     float scale = float(gi.indirect_scale);
     // Position in reduced-resolution pixel units, relative to sample centres.
     vec2 at = (vec2(pixel) + 0.5) / scale - 0.5;
@@ -39,36 +44,50 @@ vec4 upsampled_indirect(ivec2 pixel, vec3 p, vec3 n, bool glossy, out vec4 visib
     vec2 f = at - vec2(base);
     ivec2 size = imageSize(indirect);
     float tolerance = 2.0 * gi.origin.w;
-    vec4 sum = vec4(0.0);
-    float weight = 0.0;
-    for (int j = 0; j < 2; j++) {
-        for (int i = 0; i < 2; i++) {
-            ivec2 low = clamp(base + ivec2(i, j), ivec2(0), size - 1);
-            ivec2 sample_pixel = representative(low);
-            float sample_depth = texelFetch(gbuffer_depth, sample_pixel, 0).r;
-            if (sample_depth >= 1.0) {
-                continue;
-            }
-            vec3 q = pixel_position(sample_pixel, sample_depth);
-            vec3 m = normalize(imageLoad(gbuffer_normal, sample_pixel).xyz);
-            float bilinear = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
-            // Off the pixel's plane by more than two voxels, or turned away: another surface.
-            float plane = exp(-abs(dot(q - p, n)) / tolerance);
-            float w = max(bilinear, 1e-3) * plane * pow(max(dot(n, m), 0.0), 8.0);
-            sum += w * imageLoad(indirect, low);
-            if (cones) {
-                visibility_sum += w * imageLoad(shadow, low);
-            }
-            if (glossy) {
-                specular_sum += w * imageLoad(specular_low, low).rgb;
-            }
-            weight += w;
+    for (int k = 0; k < 4; k++) {
+        ivec2 corner = ivec2(k & 1, k >> 1);
+        ivec2 low = clamp(base + corner, ivec2(0), size - 1);
+        taps.low[k] = low;
+        taps.weight[k] = 0.0;
+        ivec2 sample_pixel = representative(low);
+        float sample_depth = texelFetch(gbuffer_depth, sample_pixel, 0).r;
+        if (sample_depth >= 1.0) {
+            continue;
         }
+        vec3 q = pixel_position(sample_pixel, sample_depth);
+        vec3 m = normalize(imageLoad(gbuffer_normal, sample_pixel).xyz);
+        float bilinear = (corner.x == 0 ? 1.0 - f.x : f.x) * (corner.y == 0 ? 1.0 - f.y : f.y);
+        // Off the pixel's plane by more than two voxels, or turned away: another surface.
+        float plane = exp(-abs(dot(q - p, n)) / tolerance);
+        float facing = max(dot(n, m), 0.0);
+        facing *= facing;
+        facing *= facing;
+        taps.weight[k] = max(bilinear, 1e-3) * plane * facing * facing;
+        taps.total += taps.weight[k];
     }
-    visibility = weight > 1e-6 ? visibility_sum / weight : vec4(1.0);
-    specular = weight > 1e-6 ? specular_sum / weight : vec3(0.0);
-    return weight > 1e-6 ? sum / weight : vec4(0.0, 0.0, 0.0, 1.0);
+    return taps;
 }
+
+// Defines `vec4 NAME(Taps taps, ivec2 offset)`: IMAGE upsampled (its samples at
+// `offset` from the reduced-resolution pixels), or `EMPTY` where no sample is on the
+// pixel's surface. Each image is read only where it is needed: on a CPU driver every load
+// counts. GLSL cannot pass an image to a function, hence one function per image.
+#define DEFINE_UPSAMPLED(NAME, IMAGE, EMPTY)                        \
+    vec4 NAME(Taps taps, ivec2 offset) {                            \
+        if (taps.total <= 1e-6) {                                   \
+            return EMPTY;                                           \
+        }                                                           \
+        vec4 sum = vec4(0.0);                                       \
+        for (int k = 0; k < 4; k++) {                               \
+            sum += taps.weight[k] * imageLoad(IMAGE, taps.low[k] + offset); \
+        }                                                           \
+        return sum / taps.total;                                    \
+    }
+
+DEFINE_UPSAMPLED(upsampled_indirect, indirect, vec4(0.0, 0.0, 0.0, 1.0))
+DEFINE_UPSAMPLED(upsampled_visibility, shadow, vec4(1.0))
+DEFINE_UPSAMPLED(upsampled_specular, specular_low, vec4(0.0))
+DEFINE_UPSAMPLED(upsampled_transmitted, transmitted_low, vec4(0.0))
 
 bool enabled(uint flag) {
     return (frame.flags & flag) != 0u;
@@ -97,20 +116,18 @@ void main() {
     vec3 v = normalize(frame.camera_position.xyz - p);
     vec4 albedo_specular = imageLoad(gbuffer_albedo, pixel);
     float roughness = clamp(normal_roughness.w, 0.02, 1.0);
-    vec3 start = p + n * (2.0 * gi.origin.w);
     float specular = albedo_specular.a;
     bool glossy = specular > 0.0 && enabled(FLAG_INDIRECT_SPECULAR);
 
-    vec4 cone_visibility_low;
-    vec3 reflected;
-    vec4 gathered = upsampled_indirect(pixel, p, n, glossy, cone_visibility_low, reflected);
+    Taps taps = upsample_taps(pixel, p, n);
+    vec4 gathered = upsampled_indirect(taps, ivec2(0));
     float ao = enabled(FLAG_AO) ? gathered.a : 1.0;
     vec3 indirect_light = vec3(0.0);
     if (enabled(FLAG_INDIRECT_DIFFUSE)) {
         indirect_light += albedo_specular.rgb * gathered.rgb;
     }
     if (glossy) {
-        indirect_light += specular * reflected;
+        indirect_light += specular * upsampled_specular(taps, ivec2(0)).rgb;
     }
     indirect_light *= ao;
 
@@ -121,6 +138,8 @@ void main() {
         surface = enabled(FLAG_EMISSION) ? imageLoad(gbuffer_emission, pixel).rgb : vec3(0.0);
     }
     if (shades && enabled(FLAG_DIRECT)) {
+        vec4 visibility = vec4(1.0);
+        uint band = ~0u;
         for (uint i = 0u; i < frame.light_count; i++) {
             vec3 l;
             float dist;
@@ -128,10 +147,11 @@ void main() {
             if (all(equal(e, vec3(0.0)))) {
                 continue;
             }
-            float visibility = i < CONE_SHADOW_LIGHTS
-                ? cone_visibility_low[i]
-                : cone_visibility(start, l, gi.shadow_tan_half, dist - gi.origin.w);
-            surface += surface_brdf(albedo_specular.rgb, specular, roughness, n, v, l) * e * visibility;
+            if (i / 4u != band) {
+                band = i / 4u;
+                visibility = upsampled_visibility(taps, shadow_texel(ivec2(0), band));
+            }
+            surface += surface_brdf(albedo_specular.rgb, specular, roughness, n, v, l) * e * visibility[i % 4u];
         }
     }
     surface += indirect_light;
@@ -139,13 +159,13 @@ void main() {
     vec2 transmission = imageLoad(gbuffer_transmission, pixel).rg;
     vec3 transmitted = vec3(0.0);
     if (transmission.r > 0.0 && enabled(FLAG_TRANSMISSION)) {
-        // n faces the camera: the ray enters the surface (relative index 1 / Ni).
-        vec3 t = refract(-v, n, 1.0 / max(transmission.g, 1.0));
-        vec3 dir = dot(t, t) > 0.0 ? t : reflect(-v, n);
-        // The cone leaves the surface on the side it points to.
-        vec3 side = dot(dir, n) < 0.0 ? -n : n;
-        transmitted = transmission.r * trace_cone(p + side * (2.0 * gi.origin.w), dir, roughness, 0.0, p, side, -1).rgb;
-        surface = (1.0 - transmission.r) * surface + transmitted;
+        // The refraction cones of the transmissive samples among the four (alpha: their
+        // share of the weights); where none is, the surface is drawn opaque.
+        vec4 refracted = upsampled_transmitted(taps, ivec2(0));
+        if (refracted.a > 0.0) {
+            transmitted = transmission.r * refracted.rgb / refracted.a;
+            surface = (1.0 - transmission.r) * surface + transmitted;
+        }
     }
 
     vec3 result = surface;
