@@ -118,21 +118,21 @@ fn main() {
             .unwrap()
             .1;
         let source = std::fs::read_to_string(path).unwrap();
-        // `// variant: MACRO` lines ask for one more compile with MACRO defined, named
-        // with a `_MACRO` suffix (the octree's variants of the dense GI passes).
+        // `// variant: MACRO...` lines ask for one more compile with those macros defined,
+        // named with a `_MACRO...` suffix (the octree's variants of the dense GI passes).
         let variants = std::iter::once(None).chain(
             source
                 .lines()
                 .filter_map(|l| l.trim().strip_prefix("// variant:"))
-                .map(|m| Some(m.trim().to_string())),
+                .map(|m| Some(m.split_whitespace().collect::<Vec<_>>())),
         );
         for variant in variants {
             let name = match &variant {
-                Some(m) => format!("{}_{m}", const_name(relative)),
+                Some(macros) => format!("{}_{}", const_name(relative), macros.join("_")),
                 None => const_name(relative),
             };
             let mut options = compile_options(&glsl_dir, &layout_header);
-            if let Some(m) = &variant {
+            for m in variant.iter().flatten() {
                 options.add_macro_definition(m, None);
             }
             let display = path.to_string_lossy().into_owned();
@@ -145,7 +145,9 @@ fn main() {
                     }
                     let spv = out_dir.join(format!("{name}.spv"));
                     std::fs::write(&spv, artifact.as_binary_u8()).unwrap();
-                    let with = variant.map(|m| format!(" with {m}")).unwrap_or_default();
+                    let with = variant
+                        .map(|macros| format!(" with {}", macros.join(" and ")))
+                        .unwrap_or_default();
                     writeln!(
                         module,
                         "/// SPIR-V of `glsl/{}`{with}.\npub const {name}: &[u8] = include_bytes!({:?});",

@@ -668,7 +668,9 @@ impl Renderer {
         }
         if let Some(gi) = self.gi.as_ref().filter(|_| self.indirect) {
             let voxel_view = self.settings.debug_view.shows_voxels();
-            gi.record_gather(cmd, timer, data.set, extent, voxel_view);
+            let ambient_occlusion =
+                self.settings.terms.ambient_occlusion || self.settings.debug_view == DebugView::Ao;
+            gi.record_gather(cmd, timer, data.set, extent, voxel_view, ambient_occlusion);
         }
 
         timer.begin(cmd, "composite");

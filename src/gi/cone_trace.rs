@@ -10,7 +10,8 @@ use crate::gpu_layout as layout;
 use crate::vk::{groups_2d, Context, Pipeline};
 
 pub struct ConeTracePass {
-    pipeline: Pipeline,
+    /// Without and with ambient occlusion.
+    trace: [Pipeline; 2],
     upsample: Pipeline,
 }
 
@@ -23,33 +24,43 @@ impl ConeTracePass {
         octree: bool,
     ) -> Result<Self> {
         use crate::vk::shaders as s;
-        let (trace, upsample) = if octree {
+        let (trace, trace_ao, upsample) = if octree {
             (
                 s::GI_CONE_TRACE_CONE_TRACE_COMP_VOXELS_SVO,
+                s::GI_CONE_TRACE_CONE_TRACE_COMP_VOXELS_SVO_AMBIENT_OCCLUSION,
                 s::GI_CONE_TRACE_UPSAMPLE_COMP_VOXELS_SVO,
             )
         } else {
             (
                 s::GI_CONE_TRACE_CONE_TRACE_COMP,
+                s::GI_CONE_TRACE_CONE_TRACE_COMP_AMBIENT_OCCLUSION,
                 s::GI_CONE_TRACE_UPSAMPLE_COMP,
             )
         };
-        let pipeline = Pipeline::compute(ctx, "cone_trace", trace, &set_layouts, 0)?;
+        let trace = [
+            Pipeline::compute(ctx, "cone_trace", trace, &set_layouts, 0)?,
+            Pipeline::compute(ctx, "cone_trace with AO", trace_ao, &set_layouts, 0)?,
+        ];
         let upsample = Pipeline::compute(ctx, "upsample", upsample, &set_layouts, 0)?;
-        Ok(Self { pipeline, upsample })
+        Ok(Self { trace, upsample })
     }
 
-    /// Gathers at the reduced resolution `low`.
+    /// Gathers at the reduced resolution `low`, with `ambient_occlusion` (shown or
+    /// applied) also the ambient occlusion.
     pub fn record(
         &self,
         cmd: vk::CommandBuffer,
         frame_set: vk::DescriptorSet,
         gi_set: vk::DescriptorSet,
         low: vk::Extent2D,
+        ambient_occlusion: bool,
     ) {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
-        self.pipeline
-            .dispatch(cmd, &sets, groups_2d(low, layout::SCREEN_GROUP_SIZE));
+        self.trace[usize::from(ambient_occlusion)].dispatch(
+            cmd,
+            &sets,
+            groups_2d(low, layout::SCREEN_GROUP_SIZE),
+        );
     }
 
     /// Adds the upsampled indirect light to every pixel of `extent`.

@@ -1000,7 +1000,8 @@ impl VoxelGi {
     }
 
     /// Adds the cone-traced light to `radiance` (written by the lighting pass), or with
-    /// `voxel_view` overwrites it with a debug view of the voxels.
+    /// `voxel_view` overwrites it with a debug view of the voxels; `ambient_occlusion`:
+    /// the ambient occlusion is applied or shown.
     pub fn record_gather(
         &self,
         cmd: vk::CommandBuffer,
@@ -1008,6 +1009,7 @@ impl VoxelGi {
         frame_set: vk::DescriptorSet,
         extent: vk::Extent2D,
         voxel_view: bool,
+        ambient_occlusion: bool,
     ) {
         if voxel_view {
             timer.begin(cmd, "voxel_view");
@@ -1023,7 +1025,8 @@ impl VoxelGi {
             width: extent.width.div_ceil(scale),
             height: extent.height.div_ceil(scale),
         };
-        self.cone_trace.record(cmd, frame_set, self.set, low);
+        self.cone_trace
+            .record(cmd, frame_set, self.set, low, ambient_occlusion);
         timer.end(cmd);
 
         timer.begin(cmd, "upsample");

@@ -1,5 +1,7 @@
 #version 460
 // variant: VOXELS_SVO
+// variant: AMBIENT_OCCLUSION
+// variant: VOXELS_SVO AMBIENT_OCCLUSION
 // Voxel cone tracing (Crassin et al. 2011) for one G-buffer pixel of each
 // indirect_scale² block: cosine-weighted diffuse cones over the normal's hemisphere are
 // marched front to back through the voxel radiance, the sky filling what they leave
@@ -35,8 +37,14 @@ void main() {
     // Start two voxels off the surface so the cones do not gather their own voxels, and
     // sample no finer than 2-voxel cells (the base level adds nothing measurable here:
     // Cornell box LDR-FLIP 0.1801 either way).
-    // Ambient occlusion costs one more sample per step: only when shown or applied.
-    bool with_ao = (frame.flags & FLAG_AO) != 0u || frame.debug_view == DEBUG_AO;
+    // Ambient occlusion costs one more sample per step: only when shown or applied, in
+    // its own variant (lavapipe runs this pass 15 % slower with the sampling code merely
+    // compiled in).
+#ifdef AMBIENT_OCCLUSION
+    const bool with_ao = true;
+#else
+    const bool with_ao = false;
+#endif
     vec3 start = p + n * (2.0 * gi.origin.w);
     imageStore(indirect, low, gather_diffuse(p, start, n, int(gi.diffuse_cones), 1.0, with_ao));
     // Soft shadows change at the scale of the voxels, like the indirect light: their
