@@ -102,7 +102,8 @@ pub struct CommonArgs {
     /// degrees [default: 6].
     #[arg(long)]
     pub diffuse_cones: Option<u32>,
-    /// Trace indirect light on one pixel of each NxN block and upsample, 1 to 8
+    /// Trace the cones (indirect light, soft shadows, specular, refraction) on one pixel of
+    /// each NxN block and upsample, 1 to 8
     /// [default: height / 128, at least 2: 5 at 720 rows].
     #[arg(long)]
     pub indirect_scale: Option<u32>,
