@@ -24,24 +24,28 @@ impl ConeTracePass {
         octree: bool,
     ) -> Result<Self> {
         use crate::vk::shaders as s;
-        let (trace, trace_ao, upsample) = if octree {
+        let (trace, trace_ao) = if octree {
             (
                 s::GI_CONE_TRACE_CONE_TRACE_COMP_VOXELS_SVO,
                 s::GI_CONE_TRACE_CONE_TRACE_COMP_VOXELS_SVO_AMBIENT_OCCLUSION,
-                s::GI_CONE_TRACE_UPSAMPLE_COMP_VOXELS_SVO,
             )
         } else {
             (
                 s::GI_CONE_TRACE_CONE_TRACE_COMP,
                 s::GI_CONE_TRACE_CONE_TRACE_COMP_AMBIENT_OCCLUSION,
-                s::GI_CONE_TRACE_UPSAMPLE_COMP,
             )
         };
         let trace = [
             Pipeline::compute(ctx, "cone_trace", trace, &set_layouts, 0)?,
             Pipeline::compute(ctx, "cone_trace with AO", trace_ao, &set_layouts, 0)?,
         ];
-        let upsample = Pipeline::compute(ctx, "upsample", upsample, &set_layouts, 0)?;
+        let upsample = Pipeline::compute(
+            ctx,
+            "upsample",
+            s::GI_CONE_TRACE_UPSAMPLE_COMP,
+            &set_layouts,
+            0,
+        )?;
         Ok(Self { trace, upsample })
     }
 

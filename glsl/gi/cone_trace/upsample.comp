@@ -1,5 +1,4 @@
 #version 460
-// variant: VOXELS_SVO
 // The composite of the GI terms, per pixel at full resolution:
 // - indirect diffuse: a depth- and normal-aware upsample of the gathered light (each
 //   pixel blends the four nearest reduced-resolution samples bilinearly, down-weighting
@@ -13,7 +12,8 @@
 // - transmission: transmissive pixels (d < 1) pass 1 - d of the light from the cone
 //   along the refracted ray, upsampled from the transmissive samples.
 // Each term follows its FLAG_*; the debug views show the indirect light or AO alone.
-// The cones are all traced by the cone_trace pass: this pass marches none.
+// The cones are all traced by the cone_trace pass: this pass marches none, and so reads
+// no voxels (one pipeline serves the dense grid and the octree).
 #include "common/direct_light.glsl"
 #include "gi/cone_trace/screen.glsl"
 
