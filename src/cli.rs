@@ -233,6 +233,11 @@ pub struct CompareArgs {
     /// Write the FLIP error map as a PNG here.
     #[arg(long)]
     pub map: Option<PathBuf>,
+    /// Also measure an NxN grid of blocks over the image: mean LDR-FLIP and, for EXR
+    /// inputs, the test's mean brightness over the reference's, per block (a table on
+    /// stderr, and `blocks` in the JSON).
+    #[arg(long, value_name = "N")]
+    pub blocks: Option<u32>,
 }
 
 /// Parses `WIDTHxHEIGHT`.

@@ -22,6 +22,46 @@ pub struct Metrics {
     pub rmse_linear: Option<f32>,
     /// PSNR of the LDR images, data range 1; infinite (JSON `null`) for identical images.
     pub psnr_db: f32,
+    /// With `CompareOptions::blocks`: the same per block of the image.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<BlockMetrics>,
+}
+
+/// Where in the image two renders differ: the image cut into `blocks`² blocks (rows top
+/// to bottom, each row left to right).
+#[derive(Serialize, Debug, Clone, PartialEq)]
+pub struct BlockMetrics {
+    /// Blocks per side.
+    pub blocks: u32,
+    /// Mean LDR-FLIP of each block.
+    pub flip_ldr: Vec<Vec<f32>>,
+    /// Mean linear brightness (mean of RGB) of the test over the reference's, per block;
+    /// both inputs EXR (`null` for a black reference block).
+    pub brightness_ratio: Option<Vec<Vec<Option<f32>>>>,
+}
+
+impl BlockMetrics {
+    /// A table of `flip / ratio` per block, one line per row of blocks.
+    pub fn table(&self) -> String {
+        let mut text = String::new();
+        for (y, row) in self.flip_ldr.iter().enumerate() {
+            let cells: Vec<String> = row
+                .iter()
+                .enumerate()
+                .map(|(x, flip)| {
+                    let ratio = self.brightness_ratio.as_ref().map(|r| r[y][x]);
+                    match ratio {
+                        Some(Some(r)) => format!("{flip:5.3}/{r:4.2}"),
+                        Some(None) => format!("{flip:5.3}/  - "),
+                        None => format!("{flip:5.3}"),
+                    }
+                })
+                .collect();
+            text += &cells.join(" ");
+            text.push('\n');
+        }
+        text
+    }
 }
 
 #[derive(Clone, Debug, Default)]
@@ -30,6 +70,8 @@ pub struct CompareOptions {
     pub exposure: f32,
     /// Where to write the LDR-FLIP error map (magma) as a PNG.
     pub flip_map: Option<PathBuf>,
+    /// Also measure each block of an N×N grid over the image.
+    pub blocks: Option<u32>,
 }
 
 /// flip_evaluator's default viewing conditions: 0.7 m from a 0.7 m wide, 3840 pixel wide
@@ -141,6 +183,11 @@ pub fn compare(reference: &Path, test: &Path, opts: &CompareOptions) -> Result<M
         (None, None)
     };
     let ldr_mse = mean_of(&ref_ldr.data, &test_ldr.data, |r, t| (r - t).powi(2));
+    let linear = (ref_hdr && test_hdr).then_some((&ref_image, &test_image));
+    let blocks = opts
+        .blocks
+        .map(|n| block_metrics(n, &map, ref_image.width, ref_image.height, linear))
+        .transpose()?;
     Ok(Metrics {
         reference: reference.display().to_string(),
         test: test.display().to_string(),
@@ -150,6 +197,54 @@ pub fn compare(reference: &Path, test: &Path, opts: &CompareOptions) -> Result<M
         relmse_linear: relmse,
         rmse_linear: rmse,
         psnr_db: (10.0 * (1.0 / ldr_mse).log10()) as f32,
+        blocks,
+    })
+}
+
+/// Per block of an `n`×`n` grid over a `width`×`height` image: the mean of the LDR-FLIP
+/// `map` and, given the linear reference and test images, the ratio of their mean
+/// brightness.
+fn block_metrics(
+    n: u32,
+    map: &[f32],
+    width: u32,
+    height: u32,
+    linear: Option<(&RgbImage, &RgbImage)>,
+) -> Result<BlockMetrics> {
+    if n == 0 || n > width.min(height) {
+        bail!(
+            "--blocks {n}: the image ({width}x{height}) splits into 1 to {} blocks per side",
+            width.min(height)
+        );
+    }
+    let (w, h, n_us) = (width as usize, height as usize, n as usize);
+    let span = |i: usize, size: usize| (i * size / n_us)..((i + 1) * size / n_us);
+    let block_mean = |values: &[f32], channels: usize, bx: usize, by: usize| {
+        let (mut sum, mut count) = (0.0f64, 0usize);
+        for y in span(by, h) {
+            let row = &values
+                [(y * w + span(bx, w).start) * channels..(y * w + span(bx, w).end) * channels];
+            sum += row.iter().map(|&v| f64::from(v)).sum::<f64>();
+            count += row.len();
+        }
+        sum / count as f64
+    };
+    fn grid<T>(n: usize, f: impl Fn(usize, usize) -> T) -> Vec<Vec<T>> {
+        (0..n)
+            .map(|by| (0..n).map(|bx| f(bx, by)).collect())
+            .collect()
+    }
+    let flip_ldr = grid(n_us, |bx, by| block_mean(map, 1, bx, by) as f32);
+    let brightness_ratio = linear.map(|(reference, test)| {
+        grid(n_us, |bx, by| {
+            let r = block_mean(&reference.data, 3, bx, by);
+            (r > 0.0).then(|| (block_mean(&test.data, 3, bx, by) / r) as f32)
+        })
+    });
+    Ok(BlockMetrics {
+        blocks: n,
+        flip_ldr,
+        brightness_ratio,
     })
 }
 
@@ -277,8 +372,8 @@ mod tests {
         write_exr(&pa, 8, 4, &rgba_of(&a)).unwrap();
         write_exr(&pb, 8, 4, &rgba_of(&b)).unwrap();
         let opts = CompareOptions {
-            exposure: 0.0,
             flip_map: Some(map.clone()),
+            ..Default::default()
         };
         let metrics = compare(&pa, &pb, &opts);
         let written = crate::imageio::load_rgb(&map);
@@ -288,6 +383,49 @@ mod tests {
         metrics.unwrap();
         let (image, _) = written.unwrap();
         assert_eq!((image.width, image.height), (8, 4));
+    }
+
+    /// Blocks locate a difference: a test twice as bright in its lower right quarter.
+    #[test]
+    fn blocks_locate_a_brighter_quarter() {
+        let (w, h) = (128, 64);
+        let a = gradient(w, h, 0.3);
+        let mut b = a.clone();
+        for y in h / 2..h {
+            for x in w / 2..w {
+                for c in 0..3 {
+                    b.data[((y * w + x) * 3 + c) as usize] *= 2.0;
+                }
+            }
+        }
+        let (pa, pb) = (temp_path("quarter-a.exr"), temp_path("quarter-b.exr"));
+        write_exr(&pa, w, h, &rgba_of(&a)).unwrap();
+        write_exr(&pb, w, h, &rgba_of(&b)).unwrap();
+        let opts = |blocks| CompareOptions {
+            blocks: Some(blocks),
+            ..Default::default()
+        };
+        let metrics = compare(&pa, &pb, &opts(2));
+        let too_many = compare(&pa, &pb, &opts(65));
+        for path in [&pa, &pb] {
+            std::fs::remove_file(path).ok();
+        }
+        let blocks = metrics.unwrap().blocks.unwrap();
+        let ratio = blocks.brightness_ratio.as_ref().unwrap();
+        assert!((ratio[1][1].unwrap() - 2.0).abs() < 1e-6, "{:?}", ratio);
+        // FLIP's spatial filters spread the difference a few pixels across the borders.
+        let changed = blocks.flip_ldr[1][1];
+        for (y, x) in [(0, 0), (0, 1), (1, 0)] {
+            assert!((ratio[y][x].unwrap() - 1.0).abs() < 1e-6, "{:?}", ratio);
+            assert!(
+                blocks.flip_ldr[y][x] < 0.25 * changed,
+                "{:?}",
+                blocks.flip_ldr
+            );
+        }
+        assert_eq!(blocks.table().lines().count(), 2);
+        let error = too_many.unwrap_err().to_string();
+        assert!(error.contains("--blocks 65"), "{error}");
     }
 
     fn assert_close(name: &str, got: f32, expected: f32, tolerance: f32) {
@@ -335,7 +473,7 @@ mod tests {
         write_exr(&copy, image.width, image.height, &modified).unwrap();
         let opts = CompareOptions {
             exposure: 2.0,
-            flip_map: None,
+            ..Default::default()
         };
         let m = compare(&dir.join("sibenik_main.exr"), &copy, &opts);
         std::fs::remove_file(&copy).ok();

@@ -24,8 +24,21 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let options = voxcone::compare::CompareOptions {
                 exposure: args.exposure,
                 flip_map: args.map.clone(),
+                blocks: args.blocks,
             };
             let metrics = voxcone::compare::compare(&args.reference, &args.test, &options)?;
+            if let Some(blocks) = &metrics.blocks {
+                eprintln!(
+                    "LDR-FLIP{} per block ({n}x{n}, rows top to bottom):\n{}",
+                    if blocks.brightness_ratio.is_some() {
+                        " / test brightness over reference"
+                    } else {
+                        ""
+                    },
+                    blocks.table(),
+                    n = blocks.blocks
+                );
+            }
             let text = serde_json::to_string_pretty(&metrics)?;
             println!("{text}");
             if let Some(path) = &args.json {
