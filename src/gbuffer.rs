@@ -81,39 +81,53 @@ impl GBuffer {
 }
 
 pub struct GBufferPass {
-    pipeline: Pipeline,
+    /// Without and with normal mapping.
+    pipelines: [Pipeline; 2],
 }
 
 impl GBufferPass {
     pub fn new(ctx: &Arc<Context>, set_layouts: &[vk::DescriptorSetLayout]) -> Result<Self> {
-        let pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                name: "gbuffer",
-                vertex: crate::vk::shaders::GBUFFER_GBUFFER_VERT,
-                geometry: None,
-                fragment: Some(crate::vk::shaders::GBUFFER_GBUFFER_FRAG),
-                vertex_stride: std::mem::size_of::<crate::scene::Vertex>() as u32,
-                attributes: &VERTEX_ATTRIBUTES,
-                set_layouts,
-                push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
-                color_formats: &COLOR_FORMATS,
-                depth_format: Some(DEPTH_FORMAT),
-                // Surfaces are two-sided (the references' convention).
-                cull: vk::CullModeFlags::NONE,
-                dynamic_depth_bias: false,
-                depth_clamp: false,
-            },
-        )?;
-        Ok(Self { pipeline })
+        use crate::vk::shaders as s;
+        let pipeline = |name, fragment| {
+            Pipeline::graphics(
+                ctx,
+                &GraphicsDesc {
+                    name,
+                    vertex: s::GBUFFER_GBUFFER_VERT,
+                    geometry: None,
+                    fragment: Some(fragment),
+                    vertex_stride: std::mem::size_of::<crate::scene::Vertex>() as u32,
+                    attributes: &VERTEX_ATTRIBUTES,
+                    set_layouts,
+                    push_constant_bytes: std::mem::size_of::<DrawPush>() as u32,
+                    color_formats: &COLOR_FORMATS,
+                    depth_format: Some(DEPTH_FORMAT),
+                    // Surfaces are two-sided (the references' convention).
+                    cull: vk::CullModeFlags::NONE,
+                    dynamic_depth_bias: false,
+                    depth_clamp: false,
+                },
+            )
+        };
+        Ok(Self {
+            pipelines: [
+                pipeline("gbuffer", s::GBUFFER_GBUFFER_FRAG)?,
+                pipeline(
+                    "gbuffer with normal maps",
+                    s::GBUFFER_GBUFFER_FRAG_NORMAL_MAPS,
+                )?,
+            ],
+        })
     }
 
+    /// Draws the scene into `target`; `normal_maps`: with its normal maps applied.
     pub fn record(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         target: &GBuffer,
         draw: &SceneDraw,
+        normal_maps: bool,
     ) {
         for image in target.colors() {
             image_barrier(
@@ -169,7 +183,8 @@ impl GBufferPass {
             .depth_attachment(&depth);
         unsafe { ctx.device.cmd_begin_rendering(cmd, &rendering) };
         set_viewport(ctx, cmd, extent);
-        draw.draw_meshes(ctx, cmd, &self.pipeline, 0, None, |_| true);
+        let pipeline = &self.pipelines[usize::from(normal_maps)];
+        draw.draw_meshes(ctx, cmd, pipeline, 0, None, |_| true);
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         for image in target.colors() {
             image_barrier(

@@ -176,8 +176,6 @@ gpu_layout! {
 
         /// `FrameUniforms.flags`: add the specular lobe.
         FLAG_SPECULAR = 1;
-        /// `FrameUniforms.flags`: use tangent-space normal maps.
-        FLAG_NORMAL_MAPS = 2;
         /// `FrameUniforms.flags`: filmic (ACES) tonemap instead of a plain clamp.
         FLAG_TONEMAP_ACES = 4;
         /// `FrameUniforms.flags`: add the direct light of the scene's lights.

@@ -484,9 +484,6 @@ impl Renderer {
         if s.specular {
             flags |= layout::FLAG_SPECULAR;
         }
-        if s.normal_maps {
-            flags |= layout::FLAG_NORMAL_MAPS;
-        }
         if s.tonemap == Tonemap::Aces {
             flags |= layout::FLAG_TONEMAP_ACES;
         }
@@ -635,8 +632,14 @@ impl Renderer {
         }
 
         timer.begin(cmd, "gbuffer");
+        let normal_maps = self.settings.normal_maps
+            && self
+                .scene
+                .materials
+                .iter()
+                .any(|m| m.normal_texture.is_some());
         self.gbuffer_pass
-            .record(&ctx, cmd, &self.targets.gbuffer, &draw);
+            .record(&ctx, cmd, &self.targets.gbuffer, &draw, normal_maps);
         timer.end(cmd);
 
         let gi = self.gi.as_mut().filter(|_| self.indirect);

@@ -1,4 +1,5 @@
 #version 460
+// variant: NORMAL_MAPS
 // Writes the surface attributes the lighting pass needs; position comes from depth.
 #include "common/frame.glsl"
 #include "common/scene.glsl"
@@ -12,6 +13,7 @@ layout(location = 1) out vec4 out_normal;   // xyz world normal facing the camer
 layout(location = 2) out vec4 out_emission; // rgb emitted radiance
 layout(location = 3) out vec2 out_transmission; // transmittance (1 - d), index of refraction
 
+#ifdef NORMAL_MAPS
 // Perturbs n by a tangent-space normal map with a cotangent frame from screen-space
 // derivatives (Schüler, "Normal mapping without precomputed tangents"), so meshes need
 // no tangents.
@@ -35,6 +37,7 @@ vec3 apply_normal_map(vec3 n) {
     vec3 mapped = normalize(mat3(t * scale, b * scale, n) * m);
     return any(isnan(mapped)) ? n : mapped;
 }
+#endif
 
 void main() {
     GpuMaterial m = materials[draw.material];
@@ -53,9 +56,13 @@ void main() {
     if (!front) {
         n = -n;
     }
-    if ((frame.flags & FLAG_NORMAL_MAPS) != 0u && m.normal_texture != NO_TEXTURE) {
+    // Normal mapping has its own variant: lavapipe draws the G-buffer 15 % slower with
+    // the code merely compiled in.
+#ifdef NORMAL_MAPS
+    if (m.normal_texture != NO_TEXTURE) {
         n = apply_normal_map(n);
     }
+#endif
     float specular = (frame.flags & FLAG_SPECULAR) != 0u ? dot(m.specular.rgb, vec3(1.0 / 3.0)) : 0.0;
     out_albedo = vec4(material_albedo(m, in_uv), specular);
     out_normal = vec4(n, m.specular.a);
