@@ -394,6 +394,30 @@ fn gi_bindings() -> Vec<Binding> {
     ]
 }
 
+/// Adds to `writer` what the cones sample, through the `linear` sampler: the base level
+/// `radiance` and the `directional` radiance, both kept in GENERAL layout (written as
+/// storage, sampled by the cones). The dense grid and the octree bind theirs alike.
+pub(crate) fn bind_cone_samples<'a>(
+    writer: SetWriter<'a>,
+    radiance: &Image,
+    directional: &Image,
+    linear: vk::Sampler,
+) -> SetWriter<'a> {
+    writer
+        .sampled_image(
+            layout::BINDING_GI_RADIANCE_SAMPLED,
+            radiance.view,
+            linear,
+            vk::ImageLayout::GENERAL,
+        )
+        .sampled_image(
+            layout::BINDING_GI_DIRECTIONAL,
+            directional.view,
+            linear,
+            vk::ImageLayout::GENERAL,
+        )
+}
+
 /// A global barrier between two compute passes: writes before are visible to reads and
 /// writes after.
 pub(crate) fn compute_to_compute(ctx: &Context, cmd: vk::CommandBuffer) {
@@ -479,25 +503,13 @@ impl Dense {
     ) -> Result<Self> {
         let moving_meshes = scene.has_moving_meshes();
         let volumes = Volumes::new(ctx, resolution, moving_meshes && !full_update)?;
-        SetWriter::new(ctx, set)
+        let writer = SetWriter::new(ctx, set)
             .storage_image(layout::BINDING_GI_ALBEDO, volumes.albedo.view)
             .storage_image(layout::BINDING_GI_NORMAL, volumes.normal.view)
             .storage_image(layout::BINDING_GI_EMISSION, volumes.emission.view)
             .storage_image(layout::BINDING_GI_RADIANCE, volumes.radiance.view)
-            .storage_image(layout::BINDING_GI_DIRECT, volumes.direct.view)
-            .sampled_image(
-                layout::BINDING_GI_RADIANCE_SAMPLED,
-                volumes.radiance.view,
-                linear,
-                vk::ImageLayout::GENERAL,
-            )
-            .sampled_image(
-                layout::BINDING_GI_DIRECTIONAL,
-                volumes.directional.view,
-                linear,
-                vk::ImageLayout::GENERAL,
-            )
-            .apply();
+            .storage_image(layout::BINDING_GI_DIRECT, volumes.direct.view);
+        bind_cone_samples(writer, &volumes.radiance, &volumes.directional, linear).apply();
         // The radiance volumes stay in GENERAL: written as storage, sampled by cones.
         to_compute_write(
             ctx,

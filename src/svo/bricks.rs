@@ -18,7 +18,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
-use super::octree::{compute_to_indirect, dispatch_for_level, timed_pass, Over};
+use super::octree::{compute_to_indirect, dispatch_for_level, push_and_dispatch, timed_pass, Over};
 use crate::gpu_layout::{self as layout, SvoPush, SvoUpdateList};
 use crate::vk::{stage_barrier, Context, GpuTimer, Pipeline};
 
@@ -79,8 +79,7 @@ fn dispatch_for_list(
         list,
         ..Default::default()
     };
-    pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
-    pipeline.dispatch_indirect(cmd, sets, updates, list_offset(list));
+    push_and_dispatch(pipeline, cmd, sets, &push, updates, list_offset(list));
 }
 
 pub struct BrickPasses {

@@ -58,8 +58,21 @@ pub fn dispatch_for_level(
             level_offset(level) + std::mem::offset_of!(SvoLevel, appended_groups_x) as u64
         }
     };
-    pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
-    pipeline.dispatch_indirect(cmd, sets, counters, offset);
+    push_and_dispatch(pipeline, cmd, sets, &push, counters, offset);
+}
+
+/// Pushes `push` to `pipeline`, binds it with `sets` and dispatches it with the workgroup
+/// counts at `offset` in `buffer`.
+pub(super) fn push_and_dispatch(
+    pipeline: &Pipeline,
+    cmd: vk::CommandBuffer,
+    sets: &[(u32, vk::DescriptorSet)],
+    push: &SvoPush,
+    buffer: vk::Buffer,
+    offset: u64,
+) {
+    pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, push);
+    pipeline.dispatch_indirect(cmd, sets, buffer, offset);
 }
 
 /// Records `pass` as GPU pass `name`: timed, and followed by a barrier to the next

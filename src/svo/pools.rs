@@ -8,7 +8,7 @@ use anyhow::{ensure, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use crate::gi::Grid;
+use crate::gi::{bind_cone_samples, Grid};
 use crate::gpu_layout::{
     self as layout, SvoBounceDispatch, SvoCounters, SvoUpdateList, VoxelListHeader,
 };
@@ -367,7 +367,7 @@ impl Pools {
     pub(super) fn write_set(&self, ctx: &Context, set: vk::DescriptorSet, linear: vk::Sampler) {
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         let [albedo, normal, emission] = &self.leaf_attributes;
-        SetWriter::new(ctx, set)
+        let writer = SetWriter::new(ctx, set)
             .buffer(layout::BINDING_SVO_NODES, storage, self.nodes.raw)
             .buffer(layout::BINDING_SVO_NODE_COORDS, storage, self.coords.raw)
             .buffer(layout::BINDING_SVO_NODE_BRICKS, storage, self.bricks.raw)
@@ -390,20 +390,8 @@ impl Pools {
             .storage_image(
                 layout::BINDING_SVO_DIRECTIONAL_STORAGE,
                 self.directional.view,
-            )
-            .sampled_image(
-                layout::BINDING_GI_RADIANCE_SAMPLED,
-                self.leaf_radiance.view,
-                linear,
-                vk::ImageLayout::GENERAL,
-            )
-            .sampled_image(
-                layout::BINDING_GI_DIRECTIONAL,
-                self.directional.view,
-                linear,
-                vk::ImageLayout::GENERAL,
-            )
-            .apply();
+            );
+        bind_cone_samples(writer, &self.leaf_radiance, &self.directional, linear).apply();
     }
 
     /// The state of the images before a build clears them: new (the first time), or
