@@ -89,6 +89,12 @@ gpu_layout! {
         /// GI passes (set 2): refraction cone radiance (rgb) at reduced resolution, and 1 in
         /// alpha where the traced pixel is transmissive (0 elsewhere), `rgba16f` storage.
         BINDING_GI_TRANSMITTED = 18;
+        /// Dense voxelization (set 2): per voxel, the sums of its fragments' albedo, normal and
+        /// emission (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` texels of an `r32ui`
+        /// storage image of 2n x n x 5n texels (`glsl/gi/sums.glsl`), from which the compact
+        /// pass takes the means. Atomic adds are exact and commutative, so the means do not
+        /// depend on the order in which fragments arrive.
+        BINDING_GI_SUMS = 19;
         /// filter pass (set 2): the base radiance, read by the first level, `rgba16f` storage.
         BINDING_FILTER_BASE = 0;
         /// filter pass (set 2): the directional level read (levels after the first), `rgba16f` storage.
@@ -108,7 +114,7 @@ gpu_layout! {
         BINDING_SVO_FRAGMENTS = 21;
         /// SVO passes (set 2): the voxel-fragment list, second half: per fragment its RGBA8 normal (xyz * 0.5 + 0.5) and emission / `GiUniforms.emission_range`, `uvec2[]` storage buffer.
         BINDING_SVO_FRAGMENT_SHADING = 28;
-        /// SVO passes (set 2): per node, its first child (children come in tiles of 8; 0 = none) with `SVO_SUBDIVIDE` set while flagged; for a leaf, which of its 8 voxels hold fragments (bits 0-7, voxel x | y << 1 | z << 2) and the first of their sums (bits 8-30), `uint[]` storage buffer.
+        /// SVO passes (set 2): per node, its first child (children come in tiles of 8; 0 = none) with `SVO_SUBDIVIDE` set while flagged; for a leaf, which of its 8 voxels hold fragments (bits 0-7, voxel x | y << 1 | z << 2) and the first of their sums (bits 8-31; a leaf is flagged in its coordinates instead, `SVO_LEAF_FLAGGED`), `uint[]` storage buffer.
         BINDING_SVO_NODES = 22;
         /// SVO passes (set 2): per node, its coordinates among its level's nodes (x | y << 10 | z << 20), `uint[]` storage buffer.
         BINDING_SVO_NODE_COORDS = 23;
@@ -118,10 +124,11 @@ gpu_layout! {
         BINDING_SVO_NEIGHBOURS = 25;
         /// SVO passes (set 2): the interior bricks' six directional radiances, `rgba16f` storage (sampled at `BINDING_GI_DIRECTIONAL`).
         BINDING_SVO_DIRECTIONAL_STORAGE = 26;
-        /// SVO passes (set 2): per occupied leaf voxel, the sums of its fragments' albedo, normal and emission (RGB, 0..255 each) and their count, `SVO_SUM_WORDS` words of a `uint[]` storage buffer: atomic adds are exact and commutative, so the averages do not depend on the order the fragments were listed in.
+        /// SVO passes (set 2): per occupied leaf voxel, the sums of its fragments' albedo, normal and emission (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` words of a `uint[]` storage buffer: atomic adds are exact and commutative, so the averages do not depend on the order the fragments were listed in.
         BINDING_SVO_SUMS = 27;
-        /// Words per leaf voxel in the sums buffer.
-        SVO_SUM_WORDS = 10;
+        /// Words of a voxel's fragment sums (dense grid and octree alike): albedo RGB, normal
+        /// XYZ, emission RGB, then the fragment count (`glsl/gi/sums.glsl`).
+        VOXEL_SUM_WORDS = 10;
         /// SVO passes (set 2): the light each leaf voxel gathered in the last frame, kept across an octree rebuilt around moving meshes (which assigns new bricks): two hash tables of `carry_capacity` entries (key = voxel x | y << 10 | z << 20, plus 1; then the RGB floats), `uint[]` storage buffer.
         BINDING_SVO_CARRY = 29;
         /// SVO passes (set 2): the static part's child entries as the static build left them (Dřínovský 2013, 5.7): each frame restores them, and a static leaf that a moving mesh's fragments reach reads its own voxels' mask and sums from here, `uint[]` storage buffer.
@@ -150,8 +157,10 @@ gpu_layout! {
         SVO_MAX_LEVELS = 16;
         /// Workgroup size of the passes over fragments and over a level's nodes.
         SVO_GROUP_SIZE = 64;
-        /// Bit of a node's child entry: the node is to be subdivided (or, for a leaf, holds voxels).
+        /// Bit of a node's child entry: the node is to be subdivided.
         SVO_SUBDIVIDE = 0x80000000;
+        /// Bit of a leaf's coordinates (above x | y << 10 | z << 20): fragments of the current insertion reached the leaf; set by the flag pass, cleared by the alloc pass (the leaf's child entry has no bit to spare: its first sum takes bits 8-31, for up to 2^24 leaf voxels).
+        SVO_LEAF_FLAGGED = 0x40000000;
         /// A missing node (neighbour pointers, look-ups).
         SVO_NO_NODE = 0xFFFFFFFF;
         /// A node without a brick (it holds no voxel).

@@ -101,7 +101,7 @@ uint leaf_octant(uvec3 v) {
 // (its occupied voxels' mask and first sum); the voxel must be occupied.
 uint leaf_sum_base(uint entry, uint octant) {
     uint before = bitCount(entry & ((1u << octant) - 1u) & 0xffu);
-    return SVO_SUM_WORDS * (((entry & SVO_CHILD_MASK) >> 8) + uint(before));
+    return VOXEL_SUM_WORDS * ((entry >> 8) + uint(before));
 }
 
 // The texel of voxel v in its leaf's attribute bricks; false where no leaf holds it.

@@ -226,10 +226,13 @@ struct Volumes {
     radiance: Image,
     /// Direct light only, the starting point of each bounce.
     direct: Image,
-    /// The static meshes' albedo, normal and emission, kept to start each frame's
-    /// voxelization of the moving meshes from (only when the scene has moving meshes and
-    /// the static voxels are not re-voxelized every frame).
-    static_packed: Option<[Image; 3]>,
+    /// The fragment sums the means in `albedo`, `normal` and `emission` are taken from
+    /// (`BINDING_GI_SUMS`).
+    sums: Image,
+    /// The static meshes' fragment sums, kept to start each frame's voxelization of the
+    /// moving meshes from (only when the scene has moving meshes and the static voxels
+    /// are not re-voxelized every frame).
+    static_sums: Option<Image>,
     /// +X -X +Y -Y +Z -Z side by side along x, each resolution / 2 down to 2 in its mip
     /// chain: one texture, so that a cone picks its volume by coordinate (descriptor
     /// arrays need constant indices on lavapipe, and branching over six textures costs
@@ -258,14 +261,11 @@ const RADIANCE_USE: ImageUse = ImageUse {
         vk::AccessFlags2::SHADER_READ.as_raw() | vk::AccessFlags2::SHADER_WRITE.as_raw(),
     ),
 };
-/// The packed volumes after injection: read, and the normals turned to their lit side.
-const PACKED_AFTER_INJECT: ImageUse = ImageUse {
+/// The fragment sums after the compact pass took their means.
+const SUMS_AFTER_COMPACT: ImageUse = ImageUse {
     layout: vk::ImageLayout::GENERAL,
     stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
-    access: vk::AccessFlags2::from_raw(
-        vk::AccessFlags2::SHADER_STORAGE_READ.as_raw()
-            | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
-    ),
+    access: vk::AccessFlags2::SHADER_STORAGE_READ,
 };
 const RADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
@@ -276,6 +276,13 @@ impl Volumes {
             | vk::ImageUsageFlags::TRANSFER_DST
             | vk::ImageUsageFlags::TRANSFER_SRC;
         let packed = |name| Image::new(ctx, name, ImageDesc::d3(PACKED_FORMAT, n, 1, packed_usage));
+        let sums = |name| {
+            let mut desc = ImageDesc::d3(PACKED_FORMAT, n, 1, packed_usage);
+            // `sum_texel` in glsl/gi/sums.glsl.
+            desc.extent.width = 2 * n;
+            desc.extent.depth = layout::VOXEL_SUM_WORDS.div_ceil(2) * n;
+            Image::new(ctx, name, desc)
+        };
         // TRANSFER_DST: cleared when the voxels change.
         let radiance_usage = vk::ImageUsageFlags::STORAGE
             | vk::ImageUsageFlags::SAMPLED
@@ -289,17 +296,12 @@ impl Volumes {
         );
         directional_desc.extent.width = 6 * DIRECTIONAL_SLOT * (n / 2);
         let directional = Image::new(ctx, "voxel radiance directional", directional_desc)?;
-        let static_packed = static_copies
-            .then(|| -> Result<[Image; 3]> {
-                Ok([
-                    packed("static voxel albedo")?,
-                    packed("static voxel normal")?,
-                    packed("static voxel emission")?,
-                ])
-            })
+        let static_sums = static_copies
+            .then(|| sums("static voxel sums"))
             .transpose()?;
         Ok(Self {
-            static_packed,
+            static_sums,
+            sums: sums("voxel sums")?,
             albedo: packed("voxel albedo")?,
             normal: packed("voxel normal")?,
             emission: packed("voxel emission")?,
@@ -317,10 +319,6 @@ impl Volumes {
         })
     }
 
-    fn packed(&self) -> [&Image; 3] {
-        [&self.albedo, &self.normal, &self.emission]
-    }
-
     fn bytes(&self) -> Vec<(&'static str, u64)> {
         vec![
             ("voxel_albedo", self.albedo.memory_bytes()),
@@ -332,13 +330,10 @@ impl Volumes {
                 "voxel_radiance_directional",
                 self.directional.memory_bytes(),
             ),
+            ("voxel_sums", self.sums.memory_bytes()),
             (
-                "voxel_static_copies",
-                self.static_packed
-                    .iter()
-                    .flatten()
-                    .map(Image::memory_bytes)
-                    .sum(),
+                "voxel_static_sums",
+                self.static_sums.as_ref().map_or(0, Image::memory_bytes),
             ),
         ]
     }
@@ -391,6 +386,7 @@ fn gi_bindings() -> Vec<Binding> {
             vk::DescriptorType::STORAGE_BUFFER,
             all,
         ),
+        Binding::new(layout::BINDING_GI_SUMS, storage, all),
     ]
 }
 
@@ -453,7 +449,7 @@ struct Dense {
     filter: filter::FilterPass,
     /// Re-voxelize everything every frame.
     full_update: bool,
-    /// The static meshes are in the voxels (or in `Volumes::static_packed`).
+    /// The static meshes are in the voxels (or in `Volumes::static_sums`).
     static_ready: bool,
 }
 
@@ -508,13 +504,22 @@ impl Dense {
             .storage_image(layout::BINDING_GI_NORMAL, volumes.normal.view)
             .storage_image(layout::BINDING_GI_EMISSION, volumes.emission.view)
             .storage_image(layout::BINDING_GI_RADIANCE, volumes.radiance.view)
-            .storage_image(layout::BINDING_GI_DIRECT, volumes.direct.view);
+            .storage_image(layout::BINDING_GI_DIRECT, volumes.direct.view)
+            .storage_image(layout::BINDING_GI_SUMS, volumes.sums.view);
         bind_cone_samples(writer, &volumes.radiance, &volumes.directional, linear).apply();
-        // The radiance volumes stay in GENERAL: written as storage, sampled by cones.
+        // The volumes stay in GENERAL: written as storage, the radiance sampled by cones
+        // (the sums are cleared or copied into before each voxelization).
         to_compute_write(
             ctx,
             "gi volume layouts",
-            &[&volumes.radiance, &volumes.direct, &volumes.directional],
+            &[
+                &volumes.albedo,
+                &volumes.normal,
+                &volumes.emission,
+                &volumes.radiance,
+                &volumes.direct,
+                &volumes.directional,
+            ],
         )?;
         let compact = compact::CompactPass::new(ctx, layouts, resolution)?;
         SetWriter::new(ctx, set)
@@ -540,7 +545,8 @@ impl Dense {
     }
 
     /// Voxelizes what this frame needs (the moving meshes, or everything the first time
-    /// or with `full_update`) into `set`'s volumes and lists the occupied voxels.
+    /// or with `full_update`) into `set`'s fragment sums, takes their means and lists the
+    /// occupied voxels.
     fn record_voxelize(
         &mut self,
         ctx: &Context,
@@ -551,58 +557,55 @@ impl Dense {
         n: u32,
     ) {
         let voxelized =
-            self.full_update || !self.static_ready || self.volumes.static_packed.is_some();
+            self.full_update || !self.static_ready || self.volumes.static_sums.is_some();
+        let sums = &self.volumes.sums;
         if self.full_update || !self.static_ready {
             timer.begin(cmd, "voxelize");
-            for image in self.volumes.packed() {
-                // Last frame's injection read these.
-                clear_to_zero(
-                    ctx,
-                    cmd,
-                    image,
-                    PACKED_AFTER_INJECT,
-                    voxelize::VoxelizePass::IMAGE_USE,
-                );
-            }
+            // Last frame's compact pass read the sums.
+            clear_to_zero(
+                ctx,
+                cmd,
+                sums,
+                SUMS_AFTER_COMPACT,
+                voxelize::VoxelizePass::IMAGE_USE,
+            );
             if self.full_update {
                 self.voxelize
                     .record(ctx, cmd, draw, set, n, voxelize::Meshes::All);
             } else {
                 self.voxelize
                     .record(ctx, cmd, draw, set, n, voxelize::Meshes::Static);
-                if let Some(copies) = &self.volumes.static_packed {
-                    for (image, copy) in self.volumes.packed().into_iter().zip(copies) {
-                        self.copy_packed(ctx, cmd, image, copy, ImageUse::UNDEFINED, true);
-                    }
+                if let Some(copy) = &self.volumes.static_sums {
+                    copy_sums(ctx, cmd, sums, copy, true);
                     self.voxelize
                         .record(ctx, cmd, draw, set, n, voxelize::Meshes::Moving);
                 }
                 self.static_ready = true;
             }
             timer.end(cmd);
-        } else if let Some(copies) = &self.volumes.static_packed {
-            // The moving meshes start again from the static voxels; the static meshes are
+        } else if let Some(copy) = &self.volumes.static_sums {
+            // The moving meshes start again from the static sums; the static meshes are
             // not drawn.
             timer.begin(cmd, "voxelize");
-            for (image, copy) in self.volumes.packed().into_iter().zip(copies) {
-                self.copy_packed(ctx, cmd, copy, image, ImageUse::TRANSFER_SRC, false);
-            }
+            copy_sums(ctx, cmd, sums, copy, false);
             self.voxelize
                 .record(ctx, cmd, draw, set, n, voxelize::Meshes::Moving);
             timer.end(cmd);
         }
         if voxelized {
             timer.begin(cmd, "compact");
+            // The sums are complete; last frame's injection is done with the means.
             memory_barrier(
                 ctx,
                 cmd,
                 (
-                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                    vk::PipelineStageFlags2::FRAGMENT_SHADER
+                        | vk::PipelineStageFlags2::COMPUTE_SHADER,
                     vk::AccessFlags2::SHADER_STORAGE_WRITE,
                 ),
                 (
                     vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    vk::AccessFlags2::SHADER_STORAGE_READ,
+                    vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
                 ),
             );
             self.compact.record(ctx, cmd, draw.frame_set, set, n);
@@ -613,86 +616,91 @@ impl Dense {
             timer.end(cmd);
         }
     }
+}
 
-    /// Copies packed volume `from` to `to`. `from_working` says which one is the working
-    /// volume (voxelized just before; otherwise it is overwritten after last frame's
-    /// injection). The static copies stay in TRANSFER_SRC layout between frames;
-    /// `to_before` is the state of `to` when it is a static copy.
-    fn copy_packed(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        from: &Image,
-        to: &Image,
-        to_before: ImageUse,
-        from_working: bool,
-    ) {
-        let range = from.full_range();
-        let (from_before, to_before) = if from_working {
-            (voxelize::VoxelizePass::IMAGE_USE, to_before)
-        } else {
-            (
-                ImageUse::TRANSFER_SRC,
-                ImageUse::discard_after(PACKED_AFTER_INJECT),
-            )
-        };
-        image_barrier(
-            ctx,
-            cmd,
-            from.raw,
-            range,
-            from_before,
-            ImageUse::TRANSFER_SRC,
-        );
-        image_barrier(ctx, cmd, to.raw, range, to_before, ImageUse::TRANSFER_DST);
-        let layers = vk::ImageSubresourceLayers {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            mip_level: 0,
-            base_array_layer: 0,
-            layer_count: 1,
-        };
-        let region = vk::ImageCopy {
-            src_subresource: layers,
-            src_offset: vk::Offset3D::default(),
-            dst_subresource: layers,
-            dst_offset: vk::Offset3D::default(),
-            extent: from.desc.extent,
-        };
-        unsafe {
-            ctx.device.cmd_copy_image(
-                cmd,
-                from.raw,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                to.raw,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[region],
-            )
-        };
-        let (working, copy) = if from_working { (from, to) } else { (to, from) };
-        let working_before = if from_working {
-            ImageUse::TRANSFER_SRC
-        } else {
-            ImageUse::TRANSFER_DST
-        };
+/// Copies between the working fragment sums and the static meshes' copy of them:
+/// `to_copy` after the static meshes were voxelized (the copy is written once), else back
+/// to the working sums before the moving meshes are voxelized (the working sums were read
+/// by last frame's compact pass). The copy stays in TRANSFER_SRC layout between frames.
+fn copy_sums(ctx: &Context, cmd: vk::CommandBuffer, working: &Image, copy: &Image, to_copy: bool) {
+    let range = working.full_range();
+    let (from, to) = if to_copy {
+        (working, copy)
+    } else {
+        (copy, working)
+    };
+    if to_copy {
         image_barrier(
             ctx,
             cmd,
             working.raw,
             range,
-            working_before,
             voxelize::VoxelizePass::IMAGE_USE,
+            ImageUse::TRANSFER_SRC,
         );
-        if from_working {
-            // The static copy keeps TRANSFER_SRC for the next frames' copies.
-            image_barrier(
-                ctx,
-                cmd,
-                copy.raw,
-                range,
-                ImageUse::TRANSFER_DST,
-                ImageUse::TRANSFER_SRC,
-            );
-        }
+        image_barrier(
+            ctx,
+            cmd,
+            copy.raw,
+            range,
+            ImageUse::UNDEFINED,
+            ImageUse::TRANSFER_DST,
+        );
+    } else {
+        image_barrier(
+            ctx,
+            cmd,
+            working.raw,
+            range,
+            ImageUse::discard_after(SUMS_AFTER_COMPACT),
+            ImageUse::TRANSFER_DST,
+        );
+    }
+    let layers = vk::ImageSubresourceLayers {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        mip_level: 0,
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    let region = vk::ImageCopy {
+        src_subresource: layers,
+        src_offset: vk::Offset3D::default(),
+        dst_subresource: layers,
+        dst_offset: vk::Offset3D::default(),
+        extent: working.desc.extent,
+    };
+    unsafe {
+        ctx.device.cmd_copy_image(
+            cmd,
+            from.raw,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            to.raw,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            &[region],
+        )
+    };
+    let working_after_copy = if to_copy {
+        ImageUse::TRANSFER_SRC
+    } else {
+        ImageUse::TRANSFER_DST
+    };
+    image_barrier(
+        ctx,
+        cmd,
+        working.raw,
+        range,
+        working_after_copy,
+        voxelize::VoxelizePass::IMAGE_USE,
+    );
+    if to_copy {
+        image_barrier(
+            ctx,
+            cmd,
+            copy.raw,
+            range,
+            ImageUse::TRANSFER_DST,
+            ImageUse::TRANSFER_SRC,
+        );
     }
 }
 

@@ -687,7 +687,7 @@ impl SvoGi {
             vk::PipelineStageFlags2::ALL_COMMANDS,
             vk::PipelineStageFlags2::ALL_TRANSFER,
         );
-        let sums_kept = 4 * u64::from(layout::SVO_SUM_WORDS) * u64::from(part.leaf_voxels);
+        let sums_kept = 4 * u64::from(layout::VOXEL_SUM_WORDS) * u64::from(part.leaf_voxels);
         unsafe {
             let device = &ctx.device;
             device.cmd_update_buffer(cmd, self.counters.raw, 0, &head);

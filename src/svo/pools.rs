@@ -207,7 +207,7 @@ pub(super) struct Pools {
     pub(super) directional: Image,
     /// The occupied leaf voxels with their bricks (`VoxelListHeader`, then two words each).
     pub(super) voxel_list: Buffer,
-    /// Per leaf voxel, its fragments' attribute sums and count (`SVO_SUM_WORDS` words).
+    /// Per leaf voxel, its fragments' attribute sums and count (`VOXEL_SUM_WORDS` words).
     pub(super) sums: Buffer,
     /// Two tables of `carry_capacity` entries: the light each leaf voxel gathered, kept
     /// across frames that insert meshes into the octree (only then: their bricks change).
@@ -285,10 +285,10 @@ impl Pools {
             usage | vk::ImageUsageFlags::SAMPLED,
         );
         directional_desc.extent.width = 6 * interior_edge;
-        // A leaf's first sum sits in bits 8-30 of its child entry.
+        // A leaf's first sum sits in bits 8-31 of its child entry.
         ensure!(
-            capacities.leaf_voxels < 1 << 23,
-            "the SVO needs sums for {} leaf voxels, more than the 2^23 its nodes can point \
+            capacities.leaf_voxels <= 1 << 24,
+            "the SVO needs sums for {} leaf voxels, more than the 2^24 its nodes can point \
              to: use a smaller --octree-depth",
             capacities.leaf_voxels
         );
@@ -327,7 +327,7 @@ impl Pools {
             )?,
             sums: buffer(
                 "svo fragment sums",
-                4 * u64::from(layout::SVO_SUM_WORDS) * u64::from(capacities.leaf_voxels),
+                4 * u64::from(layout::VOXEL_SUM_WORDS) * u64::from(capacities.leaf_voxels),
                 vk::BufferUsageFlags::empty(),
             )?,
             cleared: std::cell::Cell::new(false),

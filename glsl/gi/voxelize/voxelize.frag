@@ -1,20 +1,20 @@
 #version 460
-// Writes albedo, normal and emission of every voxel the (dilated) triangle covers, as
-// RGBA8 moving averages, so overlapping triangles average.
-#include "gi/average.glsl"
+// Adds albedo, normal and emission of every voxel the (dilated) triangle covers to the
+// voxel's fragment sums (gi/sums.glsl); the compact pass takes their means.
+#include "gi/sums.glsl"
 
-layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform coherent volatile uimage3D voxel_albedo;
-layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform coherent volatile uimage3D voxel_normal;
-layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform coherent volatile uimage3D voxel_emission;
-
-DEFINE_AVERAGE(average_albedo, voxel_albedo)
-DEFINE_AVERAGE(average_normal, voxel_normal)
-DEFINE_AVERAGE(average_emission, voxel_emission)
+layout(set = SET_PASS, binding = BINDING_GI_SUMS, r32ui) uniform uimage3D voxel_sums;
 
 void store_voxel(ivec3 voxel, vec3 albedo, vec3 normal, vec3 emission) {
-    average_albedo(voxel, albedo * 255.0);
-    average_normal(voxel, normal * 255.0);
-    average_emission(voxel, emission * 255.0);
+    uvec3 terms[3] = uvec3[3](sum_terms(albedo), sum_terms(normal), sum_terms(emission));
+    for (uint a = 0u; a < 3u; a++) {
+        for (uint c = 0u; c < 3u; c++) {
+            if (terms[a][c] != 0u) {
+                imageAtomicAdd(voxel_sums, sum_texel(voxel, 3u * a + c), terms[a][c]);
+            }
+        }
+    }
+    imageAtomicAdd(voxel_sums, sum_texel(voxel, SUM_COUNT), 1u);
 }
 
 #include "gi/voxelize/coverage.glsl"

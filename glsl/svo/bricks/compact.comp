@@ -12,50 +12,63 @@
 #define VOXEL_LIST_WRITER
 #include "svo/octree/level.glsl"
 #include "gi/voxel_list.glsl"
+#include "gi/sums.glsl"
 
 layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform writeonly uimage3D leaf_albedo;
 layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform writeonly uimage3D leaf_normal;
 layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform writeonly uimage3D leaf_emission;
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D leaf_radiance;
 
-void main() {
-    uint node;
-    if (!level_node(node) || node_bricks[node] == SVO_NO_BRICK) {
-        return;
-    }
+// Writes the means of `node`'s voxels into a brick given this frame (and clears the
+// radiance of its empty voxels); returns the mask of its voxels with fragments.
+uint take_means(uint node) {
     uint brick = node_bricks[node];
     ivec3 origin = brick_origin(brick, counters.leaf_pool_side, SVO_ATTRIBUTE_BRICK);
     ivec3 radiance_origin = brick_origin(brick, counters.leaf_pool_side, SVO_RADIANCE_BRICK) + 1;
     bool fresh = brick >= counters.static_leaf_bricks;
-    ivec3 first = ivec3(unpack_coord(node_coords[node])) * 2;
+    uint entry = node_children[node];
+    uint listed = 0u;
     for (int i = 0; i < 8; i++) {
         ivec3 k = ivec3(i & 1, (i >> 1) & 1, i >> 2);
-        uint entry = node_children[node];
         bool occupied = (entry & (1u << uint(i))) != 0u;
         uint base = occupied ? leaf_sum_base(entry, uint(i)) : 0u;
-        uint count = occupied ? leaf_sums[base + 9u] : 0u;
-        vec3 mean[3];
-        for (uint a = 0u; a < 3u; a++) {
-            uvec3 sum = uvec3(leaf_sums[base + 3u * a], leaf_sums[base + 3u * a + 1u], leaf_sums[base + 3u * a + 2u]);
-            mean[a] = vec3(sum) / float(max(count, 1u));
+        uint count = occupied ? leaf_sums[base + SUM_COUNT] : 0u;
+        if (count != 0u) {
+            listed |= 1u << uint(i);
         }
-        float weight = float(min(count, 255u));
-        if (fresh) {
-            imageStore(leaf_albedo, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[0], weight))));
-            imageStore(leaf_normal, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[1], weight))));
-            imageStore(leaf_emission, origin + k, uvec4(count == 0u ? 0u : pack_rgba8(vec4(mean[2], weight))));
-        }
-        if (count == 0u) {
-            if (fresh) {
-                imageStore(leaf_radiance, radiance_origin + k, vec4(0.0));
-            }
+        if (!fresh) {
             continue;
         }
-        uint index = atomicAdd(list.count, 1u);
-        list_voxels[2u * index] = pack_voxel(first + k);
-        list_voxels[2u * index + 1u] = brick;
-        if (index % VOXEL_LIST_GROUP_SIZE == 0u) {
-            atomicMax(list.groups_x, index / VOXEL_LIST_GROUP_SIZE + 1u);
+        uint means[3];
+        for (uint a = 0u; a < 3u; a++) {
+            uvec3 sum = uvec3(leaf_sums[base + 3u * a], leaf_sums[base + 3u * a + 1u], leaf_sums[base + 3u * a + 2u]);
+            means[a] = packed_mean(sum, count);
+        }
+        imageStore(leaf_albedo, origin + k, uvec4(means[0]));
+        imageStore(leaf_normal, origin + k, uvec4(means[1]));
+        imageStore(leaf_emission, origin + k, uvec4(means[2]));
+        if (count == 0u) {
+            imageStore(leaf_radiance, radiance_origin + k, vec4(0.0));
+        }
+    }
+    return listed;
+}
+
+void main() {
+    uint node;
+    bool leaf = level_node(node) && node_bricks[node] != SVO_NO_BRICK;
+    uint listed = leaf ? take_means(node) : 0u;
+    // Every invocation takes its entries together with its subgroup (none without a leaf).
+    uint index = take_list_entries(uint(bitCount(listed)));
+    if (listed == 0u) {
+        return;
+    }
+    ivec3 first = ivec3(unpack_coord(node_coords[node])) * 2;
+    for (int i = 0; i < 8; i++) {
+        if ((listed & (1u << uint(i))) != 0u) {
+            list_voxels[2u * index] = pack_voxel(first + ivec3(i & 1, (i >> 1) & 1, i >> 2));
+            list_voxels[2u * index + 1u] = node_bricks[node];
+            index++;
         }
     }
 }

@@ -8,6 +8,7 @@
 // a frame adds only the moving meshes' (a static leaf they reach has new sums that start
 // from its static ones).
 #include "svo/octree.glsl"
+#include "gi/sums.glsl"
 
 layout(local_size_x = SVO_GROUP_SIZE) in;
 
@@ -35,5 +36,5 @@ void main() {
             atomicAdd(leaf_sums[base + 3u * a + c], (words[a] >> (8u * c)) & 0xffu);
         }
     }
-    atomicAdd(leaf_sums[base + 9u], 1u);
+    atomicAdd(leaf_sums[base + SUM_COUNT], 1u);
 }

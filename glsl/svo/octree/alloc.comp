@@ -15,10 +15,16 @@ void main() {
         return;
     }
     uint entry = node_children[node];
-    if ((entry & SVO_SUBDIVIDE) == 0u) {
+    bool leaf = push.level + 1u == svo_depth();
+    if (leaf) {
+        uint coords = node_coords[node];
+        if ((coords & SVO_LEAF_FLAGGED) == 0u) {
+            return;
+        }
+        node_coords[node] = coords & ~SVO_LEAF_FLAGGED;
+    } else if ((entry & SVO_SUBDIVIDE) == 0u) {
         return;
     }
-    bool leaf = push.level + 1u == svo_depth();
     uint brick;
     if (leaf) {
         brick = atomicAdd(counters.leaf_bricks, 1u);
@@ -54,7 +60,7 @@ void main() {
                 }
                 uint from = leaf_sum_base(kept, o);
                 uint to = leaf_sum_base(fresh, o);
-                for (uint w = 0u; w < SVO_SUM_WORDS; w++) {
+                for (uint w = 0u; w < VOXEL_SUM_WORDS; w++) {
                     leaf_sums[to + w] = leaf_sums[from + w];
                 }
             }

@@ -2,7 +2,8 @@
 // Each voxel fragment from `counters.fragment_base` on descends the octree built so far
 // to its node at `push.level` and flags it for subdivision, unless it has children
 // already (a static node, when a frame inserts the moving meshes' fragments); at the leaf
-// level, it flags the leaf as holding voxels and marks its own voxel in the leaf's mask.
+// level, it marks its own voxel in the leaf's mask and flags the leaf in its coordinates
+// (`SVO_LEAF_FLAGGED`: the leaf's child entry needs all its bits for the mask and sums).
 #include "svo/octree.glsl"
 
 layout(local_size_x = SVO_GROUP_SIZE) in;
@@ -26,11 +27,15 @@ void main() {
     if (!leaf && (node_children[node] & SVO_CHILD_MASK) != 0u) {
         return;
     }
-    uint bits = SVO_SUBDIVIDE;
     if (leaf) {
-        bits |= 1u << leaf_octant(v);
-    }
-    if ((node_children[node] & bits) != bits) {
-        atomicOr(node_children[node], bits);
+        uint bit = 1u << leaf_octant(v);
+        if ((node_children[node] & bit) == 0u) {
+            atomicOr(node_children[node], bit);
+        }
+        if ((node_coords[node] & SVO_LEAF_FLAGGED) == 0u) {
+            atomicOr(node_coords[node], SVO_LEAF_FLAGGED);
+        }
+    } else if ((node_children[node] & SVO_SUBDIVIDE) == 0u) {
+        atomicOr(node_children[node], SVO_SUBDIVIDE);
     }
 }
