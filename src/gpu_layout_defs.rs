@@ -95,6 +95,9 @@ gpu_layout! {
         /// pass takes the means. Atomic adds are exact and commutative, so the means do not
         /// depend on the order in which fragments arrive.
         BINDING_GI_SUMS = 19;
+        /// Dense voxelization (set 2): the static meshes' fragment sums, laid out as
+        /// `BINDING_GI_SUMS` (read when `GiUniforms.static_sums` is 1).
+        BINDING_GI_STATIC_SUMS = 33;
         /// filter pass (set 2): the base radiance, read by the first level, `rgba16f` storage.
         BINDING_FILTER_BASE = 0;
         /// filter pass (set 2): the directional level read (levels after the first), `rgba16f` storage.
@@ -329,8 +332,8 @@ gpu_layout! {
         float ao_distance,
         /// 1: the diffuse (wide) cones step level by level, each sample twice as wide as the last (Dřínovský 2013, 5.6); 0: by `step_factor` of their diameter, as the other cones.
         uint wide_steps_by_level,
-        /// Unused.
-        uint pad1,
+        /// 1: the dense grid's compact pass adds the static meshes' fragment sums (`BINDING_GI_STATIC_SUMS`) to this frame's (a scene with moving meshes, static meshes voxelized once).
+        uint static_sums,
     }
 
     /// Head of the occupied-voxel list; the voxels follow as `uint` (x | y << 10 | z << 20).

@@ -63,8 +63,8 @@ impl CompactPass {
         Ok(Self { pipeline, list })
     }
 
-    /// Rebuilds the list from the voxel albedo (after voxelization). Waits for last
-    /// frame's bounces, which read the list.
+    /// Takes the means of the fragment sums and rebuilds the list (after voxelization).
+    /// Waits for last frame's bounces, which read the list.
     pub fn record(
         &self,
         ctx: &Context,
@@ -91,6 +91,8 @@ impl CompactPass {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
         self.pipeline
             .dispatch(cmd, &sets, groups_3d(n, layout::VOXEL_GROUP_SIZE));
+        // The list, the means and the zeroed radiance, read (the radiance also sampled)
+        // and written by the passes after.
         memory_barrier(
             ctx,
             cmd,
@@ -100,7 +102,9 @@ impl CompactPass {
             ),
             (
                 readers,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+                vk::AccessFlags2::SHADER_READ
+                    | vk::AccessFlags2::SHADER_WRITE
+                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
             ),
         );
     }
