@@ -221,9 +221,9 @@ pub(super) struct Pools {
     pub(super) changes: Buffer,
     /// The filter's update lists: their heads, then `capacities.nodes` nodes each.
     pub(super) updates: Buffer,
-    /// The images have been cleared once (they are in GENERAL layout since, read and
+    /// The images have left their initial layout (they are in GENERAL since, read and
     /// written by any pass of earlier frames).
-    pub(super) cleared: std::cell::Cell<bool>,
+    pub(super) in_general: std::cell::Cell<bool>,
 }
 
 /// The update lists' heads, at the start of `Pools::updates`.
@@ -330,7 +330,7 @@ impl Pools {
                 4 * u64::from(layout::VOXEL_SUM_WORDS) * u64::from(capacities.leaf_voxels),
                 vk::BufferUsageFlags::empty(),
             )?,
-            cleared: std::cell::Cell::new(false),
+            in_general: std::cell::Cell::new(false),
             carry_capacity,
             carry: buffer(
                 "svo carry",
@@ -394,10 +394,10 @@ impl Pools {
         bind_cone_samples(writer, &self.leaf_radiance, &self.directional, linear).apply();
     }
 
-    /// The state of the images before a build clears them: new (the first time), or
-    /// whatever any shader of an earlier frame did with them.
+    /// The state of the images before a build: new (the first time), or whatever any
+    /// shader of an earlier frame did with them.
     pub(super) fn last_use(&self) -> ImageUse {
-        if self.cleared.get() {
+        if self.in_general.get() {
             ImageUse {
                 layout: vk::ImageLayout::GENERAL,
                 stage: vk::PipelineStageFlags2::ALL_COMMANDS,
