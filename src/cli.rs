@@ -131,6 +131,10 @@ pub struct CommonArgs {
     /// by default static geometry is voxelized once and only moving meshes every frame.
     #[arg(long)]
     pub full_update: bool,
+
+    /// How the scene is voxelized (both give the same voxels)
+    #[arg(long, value_enum, default_value_t)]
+    pub voxelizer: crate::gi::voxelize::Voxelizer,
     /// Leave out the direct light.
     #[arg(long)]
     pub no_direct: bool,
@@ -334,6 +338,7 @@ impl CommonArgs {
                     cones,
                     shadow_cones,
                     full_update: self.full_update,
+                    voxelizer: self.voxelizer,
                 })
             }
             GiMode::Off => {

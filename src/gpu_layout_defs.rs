@@ -98,6 +98,12 @@ gpu_layout! {
         /// Dense voxelization (set 2): the static meshes' fragment sums, laid out as
         /// `BINDING_GI_SUMS` (read when `GiUniforms.static_sums` is 1).
         BINDING_GI_STATIC_SUMS = 33;
+        /// Compute voxelization (set 2): the scene's vertices (`scene::Vertex`: position, normal, uv), `float[]` storage buffer.
+        BINDING_GI_VERTICES = 34;
+        /// Compute voxelization (set 2): the scene's indices, `uint[]` storage buffer.
+        BINDING_GI_INDICES = 35;
+        /// Workgroup size of the compute voxelization: the lanes that walk one triangle's pixels.
+        VOXELIZE_GROUP_SIZE = 32;
         /// filter pass (set 2): the base radiance, read by the first level, `rgba16f` storage.
         BINDING_FILTER_BASE = 0;
         /// filter pass (set 2): the directional level read (levels after the first), `rgba16f` storage.
@@ -488,9 +494,9 @@ gpu_layout! {
         uint material,
         /// Index into the shadow view buffer (shadow pass only).
         uint shadow_view,
-        /// Unused.
-        uint pad0,
-        /// Unused.
-        uint pad1,
+        /// The mesh's first index in the index buffer (compute voxelization only: `BINDING_GI_INDICES`).
+        uint first_index,
+        /// Added to the mesh's indices (compute voxelization only).
+        uint vertex_offset,
     }
 }

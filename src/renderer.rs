@@ -44,6 +44,7 @@ pub struct GiSettings {
     pub shadow_cones: bool,
     /// Re-voxelize and re-shade the static geometry every frame too (benchmarks).
     pub full_update: bool,
+    pub voxelizer: crate::gi::voxelize::Voxelizer,
 }
 
 /// The terms of the final image; each can be switched.
@@ -278,7 +279,7 @@ impl Renderer {
         let composite = CompositePass::new(ctx, set_layouts, output_format)?;
         let gi = settings
             .gi
-            .map(|g| VoxelGi::new(ctx, &scene, &g, set_layouts, FRAMES_IN_FLIGHT))
+            .map(|g| VoxelGi::new(ctx, &scene, &gpu, &g, set_layouts, FRAMES_IN_FLIGHT))
             .transpose()?;
         let nearest_sampler = Sampler::new(
             ctx,

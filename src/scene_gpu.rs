@@ -35,31 +35,8 @@ impl SceneDraw<'_> {
         pass_set: Option<vk::DescriptorSet>,
         keep: impl Fn(&crate::scene::Mesh) -> bool,
     ) {
-        pipeline.bind(cmd, &[(layout::SET_FRAME, self.frame_set)]);
-        if let Some(set) = pass_set {
-            pipeline.bind_set(cmd, layout::SET_PASS, set);
-        }
-        self.gpu.bind_geometry(ctx, cmd);
-        for draw in self
-            .gpu
-            .draws
-            .iter()
-            .filter(|d| keep(&self.scene.meshes[d.mesh]))
-        {
-            let push = DrawPush {
-                model: self
-                    .scene
-                    .mesh_transform(draw.mesh, self.time_s)
-                    .to_cols_array_2d(),
-                material: draw.material,
-                shadow_view,
-                ..Default::default()
-            };
-            pipeline.bind_set(
-                cmd,
-                layout::SET_SCENE,
-                self.gpu.material_sets[draw.material as usize],
-            );
+        self.for_each_mesh(ctx, cmd, pipeline, pass_set, keep, |draw, mut push| {
+            push.shadow_view = shadow_view;
             pipeline.push(
                 cmd,
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
@@ -75,6 +52,80 @@ impl SceneDraw<'_> {
                     0,
                 )
             };
+        });
+    }
+
+    /// Binds the compute `pipeline` and `pass_set` (set 2, which holds the geometry as
+    /// storage buffers), then dispatches one workgroup per triangle of every mesh that
+    /// `keep` accepts, with its model matrix, material, first index and vertex offset in
+    /// the push constants (at most `max_groups` workgroups per dispatch).
+    pub fn dispatch_triangles(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        pipeline: &Pipeline,
+        pass_set: vk::DescriptorSet,
+        max_groups: u32,
+        keep: impl Fn(&crate::scene::Mesh) -> bool,
+    ) {
+        self.for_each_mesh(
+            ctx,
+            cmd,
+            pipeline,
+            Some(pass_set),
+            keep,
+            |draw, mut push| {
+                push.vertex_offset = draw.vertex_offset as u32;
+                let triangles = draw.index_count / 3;
+                for start in (0..triangles).step_by(max_groups as usize) {
+                    push.first_index = draw.first_index + 3 * start;
+                    pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
+                    let groups = (triangles - start).min(max_groups);
+                    unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
+                }
+            },
+        );
+    }
+
+    /// Binds `pipeline`, set 0, `pass_set` and (for draws) the geometry, then for every
+    /// mesh that `keep` accepts binds its material's set and calls `record` with its
+    /// draw and push constants (model matrix and material).
+    fn for_each_mesh(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        pipeline: &Pipeline,
+        pass_set: Option<vk::DescriptorSet>,
+        keep: impl Fn(&crate::scene::Mesh) -> bool,
+        mut record: impl FnMut(&Draw, DrawPush),
+    ) {
+        pipeline.bind(cmd, &[(layout::SET_FRAME, self.frame_set)]);
+        if let Some(set) = pass_set {
+            pipeline.bind_set(cmd, layout::SET_PASS, set);
+        }
+        if !pipeline.is_compute() {
+            self.gpu.bind_geometry(ctx, cmd);
+        }
+        for draw in self
+            .gpu
+            .draws
+            .iter()
+            .filter(|d| keep(&self.scene.meshes[d.mesh]))
+        {
+            pipeline.bind_set(
+                cmd,
+                layout::SET_SCENE,
+                self.gpu.material_sets[draw.material as usize],
+            );
+            let push = DrawPush {
+                model: self
+                    .scene
+                    .mesh_transform(draw.mesh, self.time_s)
+                    .to_cols_array_2d(),
+                material: draw.material,
+                ..Default::default()
+            };
+            record(draw, push);
         }
     }
 }

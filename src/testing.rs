@@ -19,6 +19,7 @@ pub fn gi_settings(voxels: u32, structure: VoxelStructure, full_update: bool) ->
             cones: ConeSettings::default(),
             shadow_cones: false,
             full_update,
+            voxelizer: Default::default(),
         }),
         ..Default::default()
     }

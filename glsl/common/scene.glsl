@@ -12,18 +12,30 @@ layout(set = SET_SCENE, binding = BINDING_ALBEDO_TEXTURE) uniform sampler2D albe
 layout(set = SET_SCENE, binding = BINDING_COVERAGE_TEXTURE) uniform sampler2D coverage_texture;
 layout(set = SET_SCENE, binding = BINDING_NORMAL_TEXTURE) uniform sampler2D normal_texture;
 
+// How the material textures are sampled: implicitly over the fragment's footprint, or,
+// where a shader defines MATERIAL_GRADIENTS (compute shaders have no implicit
+// derivatives), over the footprint with uv gradients `material_dx` and `material_dy`,
+// which it sets before sampling.
+#ifdef MATERIAL_GRADIENTS
+vec2 material_dx;
+vec2 material_dy;
+#define SAMPLE_MATERIAL(TEXTURE, UV) textureGrad(TEXTURE, UV, material_dx, material_dy)
+#else
+#define SAMPLE_MATERIAL(TEXTURE, UV) texture(TEXTURE, UV)
+#endif
+
 // Kd x map_Kd.
 vec3 material_albedo(GpuMaterial m, vec2 uv) {
     vec3 albedo = m.albedo.rgb;
     if (m.albedo_texture != NO_TEXTURE) {
-        albedo *= texture(albedo_texture, uv).rgb;
+        albedo *= SAMPLE_MATERIAL(albedo_texture, uv).rgb;
     }
     return albedo;
 }
 
 // Cut-out mask: map_d (coverage textures hold it in every channel), 1 without one.
 float material_cutout(GpuMaterial m, vec2 uv) {
-    return m.coverage_texture != NO_TEXTURE ? texture(coverage_texture, uv).r : 1.0;
+    return m.coverage_texture != NO_TEXTURE ? SAMPLE_MATERIAL(coverage_texture, uv).r : 1.0;
 }
 
 // Opacity: map_d times d. Shadow maps and voxels hold the surfaces at least half opaque;

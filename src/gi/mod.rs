@@ -29,7 +29,7 @@ use crate::gbuffer::GBuffer;
 use crate::gpu_layout::{self as layout, GiUniforms};
 use crate::renderer::GiSettings;
 use crate::scene::{Aabb, Scene};
-use crate::scene_gpu::SceneDraw;
+use crate::scene_gpu::{GpuScene, SceneDraw};
 use crate::svo::{Capacities, SvoGi};
 use crate::vk::{
     clear_to_zero, image_barrier, memory_barrier, read_back_image, sampler_info, Binding, Buffer,
@@ -350,7 +350,7 @@ fn gi_bindings() -> Vec<Binding> {
         | vk::ShaderStageFlags::GEOMETRY;
     let storage = vk::DescriptorType::STORAGE_IMAGE;
     let sampled = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
-    vec![
+    let mut bindings = vec![
         Binding::new(
             layout::BINDING_GI_UNIFORMS,
             vk::DescriptorType::UNIFORM_BUFFER,
@@ -380,7 +380,9 @@ fn gi_bindings() -> Vec<Binding> {
         ),
         Binding::new(layout::BINDING_GI_SUMS, storage, all),
         Binding::new(layout::BINDING_GI_STATIC_SUMS, storage, all),
-    ]
+    ];
+    bindings.extend(voxelize::geometry_bindings());
+    bindings
 }
 
 /// Adds to `writer` what the cones sample, through the `linear` sampler: the base level
@@ -484,12 +486,13 @@ impl Dense {
     fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
-        resolution: u32,
-        full_update: bool,
+        settings: &GiSettings,
         set: vk::DescriptorSet,
         layouts: [vk::DescriptorSetLayout; 3],
         linear: vk::Sampler,
     ) -> Result<Self> {
+        let (resolution, full_update) = (settings.voxels, settings.full_update);
+        let voxelizer = settings.voxelizer;
         let volumes = Volumes::new(ctx, resolution, dense_keeps_static_sums(scene, full_update))?;
         let writer = SetWriter::new(ctx, set)
             .storage_image(layout::BINDING_GI_ALBEDO, volumes.albedo.view)
@@ -541,7 +544,9 @@ impl Dense {
             voxelize: voxelize::VoxelizePass::new(
                 ctx,
                 "voxelize",
+                voxelizer,
                 crate::vk::shaders::GI_VOXELIZE_VOXELIZE_FRAG,
+                crate::vk::shaders::GI_VOXELIZE_VOXELIZE_COMP,
                 layouts,
             )?,
             filter: filter::FilterPass::new(ctx, [layouts[0], layouts[1]], &volumes)?,
@@ -576,7 +581,7 @@ impl Dense {
                     vk::AccessFlags2::SHADER_STORAGE_WRITE,
                 ),
                 (
-                    vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                    voxelize::STAGES,
                     vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
                 ),
             );
@@ -691,10 +696,11 @@ fn keep_static_sums(ctx: &Context, cmd: vk::CommandBuffer, working: &Image, copy
 
 impl VoxelGi {
     /// `set_layouts` are those of sets 0 and 1; `frames_in_flight` frames may be recorded
-    /// before the first is done.
+    /// before the first is done. The compute voxelizer reads `gpu`'s geometry.
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
+        gpu: &GpuScene,
         settings: &GiSettings,
         set_layouts: [vk::DescriptorSetLayout; 2],
         frames_in_flight: usize,
@@ -737,12 +743,15 @@ impl VoxelGi {
         bindings.extend(crate::svo::bindings());
         let sets = DescriptorSets::new(ctx, "gi", &bindings, 1)?;
         let set = sets.allocate("gi")?;
+        let storage = vk::DescriptorType::STORAGE_BUFFER;
         SetWriter::new(ctx, set)
             .buffer(
                 layout::BINDING_GI_UNIFORMS,
                 vk::DescriptorType::UNIFORM_BUFFER,
                 uniforms.raw,
             )
+            .buffer(layout::BINDING_GI_VERTICES, storage, gpu.vertices.raw)
+            .buffer(layout::BINDING_GI_INDICES, storage, gpu.indices.raw)
             .apply();
         let linear = Sampler::new(
             ctx,
@@ -755,13 +764,7 @@ impl VoxelGi {
         let octree = !matches!(settings.structure, VoxelStructure::Dense);
         let voxels = match settings.structure {
             VoxelStructure::Dense => Voxels::Dense(Box::new(Dense::new(
-                ctx,
-                scene,
-                resolution,
-                settings.full_update,
-                set,
-                layouts,
-                linear.raw,
+                ctx, scene, settings, set, layouts, linear.raw,
             )?)),
             VoxelStructure::Octree { capacities } => Voxels::Octree(Box::new(SvoGi::new(
                 ctx,
@@ -773,6 +776,7 @@ impl VoxelGi {
                 linear.raw,
                 frames_in_flight,
                 settings.full_update,
+                settings.voxelizer,
             )?)),
         };
         Ok(Self {
@@ -957,7 +961,7 @@ impl VoxelGi {
             ctx,
             cmd,
             (
-                vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                voxelize::STAGES,
                 vk::AccessFlags2::SHADER_STORAGE_WRITE | vk::AccessFlags2::SHADER_STORAGE_READ,
             ),
             (

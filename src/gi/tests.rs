@@ -6,6 +6,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::reference;
+use super::voxelize::Voxelizer;
 use super::{Grid, Volume};
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
@@ -31,10 +32,18 @@ fn occupancy(renderer: &Renderer) -> Vec<bool> {
 }
 
 /// Every voxel a triangle touches is occupied on the GPU, and the GPU's conservative
-/// rasterization adds none farther than one voxel from a triangle.
+/// coverage adds none farther than one voxel from a triangle, with either voxelizer.
 fn check_voxelization(scene: Scene, n: u32) {
+    for voxelizer in [Voxelizer::Raster, Voxelizer::Compute] {
+        check_voxelization_by(scene.clone(), n, voxelizer);
+    }
+}
+
+fn check_voxelization_by(scene: Scene, n: u32, voxelizer: Voxelizer) {
     let triangles = reference::world_triangles(&scene);
-    let (ctx, renderer) = render(scene, n);
+    let mut settings = gi_settings(n, super::VoxelStructure::Dense, false);
+    settings.gi.as_mut().unwrap().voxelizer = voxelizer;
+    let (ctx, renderer) = render_frames(scene, settings, &[0.0]);
     let grid: Grid = renderer.gi().unwrap().grid;
     let gpu = occupancy(&renderer);
     let exact = reference::voxelize(&triangles, &grid);
@@ -43,7 +52,10 @@ fn check_voxelization(scene: Scene, n: u32) {
     let extra = near.iter().zip(&gpu).filter(|(c, g)| !**c && **g).count();
     let cpu_count = exact.iter().filter(|c| **c).count();
     let gpu_count = gpu.iter().filter(|g| **g).count();
-    eprintln!("{n}^3: CPU {cpu_count} voxels, GPU {gpu_count}, missing {missing}, too far {extra}");
+    eprintln!(
+        "{n}^3, {voxelizer:?}: CPU {cpu_count} voxels, GPU {gpu_count}, missing {missing}, \
+         too far {extra}"
+    );
     assert!(cpu_count > 0);
     assert_eq!(missing, 0, "voxels the CPU marks but the GPU does not");
     assert_eq!(

@@ -23,7 +23,7 @@ use anyhow::{bail, ensure, Context as _, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use crate::gi::voxelize::{Meshes, VoxelizePass};
+use crate::gi::voxelize::{Meshes, VoxelizePass, Voxelizer};
 use crate::gi::{compute_to_compute, reset_voxel_list, Grid};
 use crate::gpu_layout::{self as layout, SvoBounceDispatch, SvoCounters, SvoLevel};
 use crate::scene::{Aabb, Scene};
@@ -195,7 +195,8 @@ impl SvoGi {
     /// written, with `linear` as the radiance pools' sampler). `capacities` overrides the
     /// first guess of the pool sizes (the overflow test starts from tiny pools).
     /// `frames_in_flight` frames may be recorded before the first is done. With
-    /// `full_update` every frame voxelizes every mesh and rebuilds the octree.
+    /// `full_update` every frame voxelizes every mesh and rebuilds the octree. The
+    /// fragments are listed by `voxelizer`.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: &Arc<Context>,
@@ -207,6 +208,7 @@ impl SvoGi {
         linear: vk::Sampler,
         frames_in_flight: usize,
         full_update: bool,
+        voxelizer: Voxelizer,
     ) -> Result<Self> {
         check_depth(depth)?;
         let grid = Grid::around(scene, 1 << depth);
@@ -241,7 +243,9 @@ impl SvoGi {
             voxelize: VoxelizePass::new(
                 ctx,
                 "svo fragments",
+                voxelizer,
                 crate::vk::shaders::SVO_FRAGMENTS_FRAGMENTS_FRAG,
+                crate::vk::shaders::GI_VOXELIZE_VOXELIZE_COMP_VOXELS_SVO,
                 layouts,
             )?,
             octree: octree::OctreePasses::new(ctx, layouts)?,
@@ -541,7 +545,7 @@ impl SvoGi {
             self.counters.raw,
             0,
             bytemuck::bytes_of(&counters),
-            vk::PipelineStageFlags2::FRAGMENT_SHADER,
+            crate::gi::voxelize::STAGES,
         );
         let meshes = if self.moving {
             Meshes::Static

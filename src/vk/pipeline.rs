@@ -128,6 +128,10 @@ impl Pipeline {
         unsafe { self.ctx.device.cmd_dispatch_indirect(cmd, args, offset) };
     }
 
+    pub fn is_compute(&self) -> bool {
+        self.bind_point == vk::PipelineBindPoint::COMPUTE
+    }
+
     /// Binds one more descriptor set to the bound pipeline.
     pub fn bind_set(&self, cmd: vk::CommandBuffer, index: u32, set: vk::DescriptorSet) {
         unsafe {

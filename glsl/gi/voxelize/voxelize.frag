@@ -1,22 +1,7 @@
 #version 460
-// Adds albedo, normal and emission of every voxel the (dilated) triangle covers to the
-// voxel's fragment sums (gi/sums.glsl); the compact pass takes their means.
-#include "gi/sums.glsl"
-
-layout(set = SET_PASS, binding = BINDING_GI_SUMS, r32ui) uniform uimage3D voxel_sums;
-
-void store_voxel(ivec3 voxel, vec3 albedo, vec3 normal, vec3 emission) {
-    uvec3 terms[3] = uvec3[3](sum_terms(albedo), sum_terms(normal), sum_terms(emission));
-    for (uint a = 0u; a < 3u; a++) {
-        for (uint c = 0u; c < 3u; c++) {
-            if (terms[a][c] != 0u) {
-                imageAtomicAdd(voxel_sums, sum_texel(voxel, 3u * a + c), terms[a][c]);
-            }
-        }
-    }
-    imageAtomicAdd(voxel_sums, sum_texel(voxel, SUM_COUNT), 1u);
-}
-
+// Rasterized voxelization into the dense grid: every voxel the (dilated) triangle covers
+// gets the fragment's attributes added to its sums.
+#include "gi/voxelize/store_sums.glsl"
 #include "gi/voxelize/coverage.glsl"
 
 void main() {

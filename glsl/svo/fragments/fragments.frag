@@ -1,25 +1,6 @@
 #version 460
-// Appends one record per voxel the (dilated) triangle covers to the voxel-fragment list,
-// through an atomic counter (Dřínovský 2013, 5.2.1). Past the list's capacity fragments
-// are counted but not stored: the host sees the overflow, grows the list and builds
-// again. The invocation that opens a workgroup's worth of records raises the indirect
-// dispatch of the passes over the fragments (those from `counters.fragment_base` on).
-#include "svo/octree.glsl"
-
-void store_voxel(ivec3 voxel, vec3 albedo, vec3 normal, vec3 emission) {
-    uint index = atomicAdd(counters.fragment_count, 1u);
-    if (index >= counters.fragment_capacity) {
-        atomicOr(counters.overflow, SVO_OVERFLOW_FRAGMENTS);
-        return;
-    }
-    fragment_voxels[index] = uvec2(pack_coord(uvec3(voxel)), pack_rgba8(vec4(albedo * 255.0, 255.0)));
-    fragment_shading[index] = uvec2(pack_rgba8(vec4(normal * 255.0, 255.0)), pack_rgba8(vec4(emission * 255.0, 255.0)));
-    uint read = index - counters.fragment_base;
-    if (read % SVO_GROUP_SIZE == 0u) {
-        atomicMax(counters.fragment_groups_x, read / SVO_GROUP_SIZE + 1u);
-    }
-}
-
+// Rasterized voxelization into the octree's voxel-fragment list.
+#include "svo/fragments/store_fragment.glsl"
 #include "gi/voxelize/coverage.glsl"
 
 void main() {
