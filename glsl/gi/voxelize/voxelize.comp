@@ -8,6 +8,7 @@
 // sums, the octree appends to its voxel-fragment list.
 // variant: VOXELS_SVO
 #define MATERIAL_GRADIENTS
+#define SUBGROUP_APPEND
 #ifdef VOXELS_SVO
 #include "svo/fragments/store_fragment.glsl"
 #else
