@@ -56,35 +56,38 @@ impl SceneDraw<'_> {
     }
 
     /// Binds the compute `pipeline` and `pass_set` (set 2, which holds the geometry as
-    /// storage buffers), then dispatches one workgroup per triangle of every mesh that
+    /// storage buffers), then dispatches workgroups for every triangle of every mesh that
     /// `keep` accepts, with its model matrix, material, first index and vertex offset in
-    /// the push constants (at most `max_groups` workgroups per dispatch).
+    /// the push constants: `slices(longest edge in world units)` workgroups per triangle
+    /// along y, at most `max_groups` per dispatch along each axis.
+    #[allow(clippy::too_many_arguments)]
     pub fn dispatch_triangles(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         pipeline: &Pipeline,
         pass_set: vk::DescriptorSet,
-        max_groups: u32,
+        max_groups: [u32; 2],
+        slices: impl Fn(f32) -> u32,
         keep: impl Fn(&crate::scene::Mesh) -> bool,
     ) {
-        self.for_each_mesh(
-            ctx,
-            cmd,
-            pipeline,
-            Some(pass_set),
-            keep,
-            |draw, mut push| {
-                push.vertex_offset = draw.vertex_offset as u32;
-                let triangles = draw.index_count / 3;
-                for start in (0..triangles).step_by(max_groups as usize) {
-                    push.first_index = draw.first_index + 3 * start;
-                    pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
-                    let groups = (triangles - start).min(max_groups);
-                    unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
-                }
-            },
-        );
+        let record = |draw: &Draw, mut push: DrawPush| {
+            push.vertex_offset = draw.vertex_offset as u32;
+            let model = glam::Mat4::from_cols_array_2d(&push.model);
+            let scale = [model.x_axis, model.y_axis, model.z_axis]
+                .map(|a| a.truncate().length())
+                .into_iter()
+                .fold(0.0, f32::max);
+            let along_y = slices(draw.longest_edge * scale).clamp(1, max_groups[1]);
+            let triangles = draw.index_count / 3;
+            for start in (0..triangles).step_by(max_groups[0] as usize) {
+                push.first_index = draw.first_index + 3 * start;
+                pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
+                let groups = (triangles - start).min(max_groups[0]);
+                unsafe { ctx.device.cmd_dispatch(cmd, groups, along_y, 1) };
+            }
+        };
+        self.for_each_mesh(ctx, cmd, pipeline, Some(pass_set), keep, record);
     }
 
     /// Binds `pipeline`, set 0, `pass_set` and (for draws) the geometry, then for every
@@ -138,6 +141,9 @@ pub struct Draw {
     pub index_count: u32,
     pub vertex_offset: i32,
     pub material: u32,
+    /// The longest edge of the mesh's triangles, in object space (the compute voxelizer
+    /// sizes its dispatch by it).
+    pub longest_edge: f32,
 }
 
 pub struct GpuScene {
@@ -192,6 +198,7 @@ impl GpuScene {
                 index_count: mesh.indices.len() as u32,
                 vertex_offset: vertices.len() as i32,
                 material: mesh.material,
+                longest_edge: longest_edge(mesh),
             });
             vertices.extend_from_slice(&mesh.vertices);
             indices.extend_from_slice(&mesh.indices);
@@ -346,6 +353,16 @@ impl GpuScene {
     pub fn sampler(&self) -> vk::Sampler {
         self.sampler.raw
     }
+}
+
+/// The longest edge of `mesh`'s triangles, in object space.
+fn longest_edge(mesh: &crate::scene::Mesh) -> f32 {
+    let position = |i: u32| glam::Vec3::from(mesh.vertices[i as usize].position);
+    mesh.indices
+        .chunks_exact(3)
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .map(|(a, b)| position(a).distance(position(b)))
+        .fold(0.0, f32::max)
 }
 
 fn upload_texture(

@@ -567,8 +567,9 @@ impl Dense {
         timer: &mut GpuTimer,
         draw: &SceneDraw,
         set: vk::DescriptorSet,
-        n: u32,
+        grid: &Grid,
     ) {
+        let n = grid.resolution;
         let voxelized =
             self.full_update || !self.static_ready || self.volumes.static_sums.is_some();
         if voxelized {
@@ -590,14 +591,14 @@ impl Dense {
             timer.begin(cmd, "voxelize");
             if self.full_update {
                 self.voxelize
-                    .record(ctx, cmd, draw, set, n, voxelize::Meshes::All);
+                    .record(ctx, cmd, draw, set, grid, voxelize::Meshes::All);
             } else {
                 self.voxelize
-                    .record(ctx, cmd, draw, set, n, voxelize::Meshes::Static);
+                    .record(ctx, cmd, draw, set, grid, voxelize::Meshes::Static);
                 if let Some(copy) = &self.volumes.static_sums {
                     keep_static_sums(ctx, cmd, &self.volumes.sums, copy);
                     self.voxelize
-                        .record(ctx, cmd, draw, set, n, voxelize::Meshes::Moving);
+                        .record(ctx, cmd, draw, set, grid, voxelize::Meshes::Moving);
                 }
                 self.static_ready = true;
             }
@@ -606,7 +607,7 @@ impl Dense {
             // Only the moving meshes are drawn; the compact pass adds the static sums.
             timer.begin(cmd, "voxelize");
             self.voxelize
-                .record(ctx, cmd, draw, set, n, voxelize::Meshes::Moving);
+                .record(ctx, cmd, draw, set, grid, voxelize::Meshes::Moving);
             timer.end(cmd);
         }
         if voxelized {
@@ -943,7 +944,7 @@ impl VoxelGi {
         let mut rebuilt = false;
         let list = match &mut self.voxels {
             Voxels::Dense(dense) => {
-                dense.record_voxelize(ctx, cmd, timer, draw, set, n);
+                dense.record_voxelize(ctx, cmd, timer, draw, set, &self.grid);
                 dense.compact.list.raw
             }
             // Built before the first frame; moving meshes inserted every frame.

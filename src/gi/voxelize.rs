@@ -9,6 +9,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
+use super::Grid;
 use crate::gpu_layout::{self as layout, DrawPush};
 use crate::scene::Mesh;
 use crate::scene_gpu::{SceneDraw, VERTEX_ATTRIBUTES};
@@ -38,6 +39,10 @@ impl Voxelizer {
         }
     }
 }
+
+/// The most pixels of a triangle that one lane of the compute voxelizer walks (more
+/// pixels get more workgroups).
+const PIXELS_PER_LANE: u32 = 64;
 
 /// The shader stages that voxelize, with either voxelizer.
 pub const STAGES: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::from_raw(
@@ -97,14 +102,14 @@ impl VoxelizePass {
         Ok(Self { pipeline })
     }
 
-    /// Voxelizes the meshes of `which` into an `n`³ grid.
+    /// Voxelizes the meshes of `which` into `grid`.
     pub fn record(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         draw: &SceneDraw,
         gi_set: vk::DescriptorSet,
-        n: u32,
+        grid: &Grid,
         which: Meshes,
     ) {
         let keep = |mesh: &Mesh| match which {
@@ -113,13 +118,22 @@ impl VoxelizePass {
             Meshes::Moving => mesh.animation.is_some(),
         };
         if self.pipeline.is_compute() {
-            let max_groups = ctx.properties.limits.max_compute_work_group_count[0];
-            draw.dispatch_triangles(ctx, cmd, &self.pipeline, gi_set, max_groups, keep);
+            let limits = ctx.properties.limits.max_compute_work_group_count;
+            // A triangle's projection spans at most about (edge / voxel + 2)^2 pixels,
+            // shared among workgroups of at most PIXELS_PER_LANE per lane (one workgroup
+            // walking a floor triangle of Sponza's at 1024^3 alone took 15 ms).
+            let slices = |edge: f32| {
+                let pixels = (edge / grid.voxel_size + 2.0).powi(2);
+                let per_group = (layout::VOXELIZE_GROUP_SIZE * PIXELS_PER_LANE) as f32;
+                (pixels / per_group).ceil() as u32
+            };
+            let max_groups = [limits[0], limits[1]];
+            draw.dispatch_triangles(ctx, cmd, &self.pipeline, gi_set, max_groups, slices, keep);
             return;
         }
         let extent = vk::Extent2D {
-            width: n,
-            height: n,
+            width: grid.resolution,
+            height: grid.resolution,
         };
         let rendering = vk::RenderingInfo::default()
             .render_area(vk::Rect2D {

@@ -567,7 +567,7 @@ impl SvoGi {
         let ctx = &self.ctx;
         timer.begin(cmd, "fragments");
         self.voxelize
-            .record(ctx, cmd, draw, set, self.grid.resolution, meshes);
+            .record(ctx, cmd, draw, set, &self.grid, meshes);
         stage_barrier(
             ctx,
             cmd,

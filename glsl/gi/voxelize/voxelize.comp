@@ -1,11 +1,12 @@
 #version 460
-// Compute voxelization: one workgroup per triangle of the mesh in the push constants. Its
-// lanes walk the pixels of the triangle's dilated axis projection (gi/voxelize/
-// triangle.glsl) and cover each pixel whose centre lies inside, as the rasterizer's
-// fragments do (gi/voxelize/coverage.glsl), with the attributes interpolated there and
-// the textures sampled over the pixel's footprint. On GPUs that draw with few units (an
-// H100) this is much faster than the rasterizer. The dense grid adds to its fragment
-// sums, the octree appends to its voxel-fragment list.
+// Compute voxelization: workgroups along x for the triangles of the mesh in the push
+// constants, along y for shares of a large triangle's pixels (the host sizes them by the
+// mesh's longest edge). The lanes walk the pixels of the triangle's dilated axis
+// projection (gi/voxelize/triangle.glsl) and cover each pixel whose centre lies inside,
+// as the rasterizer's fragments do (gi/voxelize/coverage.glsl), with the attributes
+// interpolated there and the textures sampled over the pixel's footprint. On GPUs that
+// draw with few units (an H100) this is much faster than the rasterizer. The dense grid
+// adds to its fragment sums, the octree appends to its voxel-fragment list.
 // variant: VOXELS_SVO
 #define MATERIAL_GRADIENTS
 #define SUBGROUP_APPEND
@@ -58,7 +59,9 @@ void main() {
     }
     uint width = uint(hi.x - lo.x + 1);
     uint pixels = width * uint(hi.y - lo.y + 1);
-    for (uint k = gl_LocalInvocationID.x; k < pixels; k += VOXELIZE_GROUP_SIZE) {
+    // A large triangle's pixels are shared among the workgroups along y.
+    uint lanes = VOXELIZE_GROUP_SIZE * gl_NumWorkGroups.y;
+    for (uint k = gl_WorkGroupID.y * VOXELIZE_GROUP_SIZE + gl_LocalInvocationID.x; k < pixels; k += lanes) {
         vec2 pixel = vec2(lo + ivec2(k % width, k / width)) + 0.5;
         vec3 p = vec3(pixel, 1.0);
         // Centres on an edge count (the rasterizer takes some by its tie rule).
