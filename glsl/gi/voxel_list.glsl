@@ -25,20 +25,16 @@ layout(set = SET_PASS, binding = BINDING_GI_VOXEL_LIST, std430) buffer VoxelList
 #endif
 
 #ifdef VOXEL_LIST_WRITER
-#extension GL_KHR_shader_subgroup_arithmetic : require
-#extension GL_KHR_shader_subgroup_ballot : require
-// Where this invocation's `entries` entries start: each subgroup takes its entries with one
-// atomic add (one add per entry serializes on the counter: 4.9 ms for Sponza's 500,000
-// voxels on an H100) and raises the indirect dispatch to cover them.
+#include "gi/subgroup_add.glsl"
+// Where this invocation's `entries` entries start (its subgroup takes them with one
+// atomic add); raises the indirect dispatch to cover them.
 uint take_list_entries(uint entries) {
-    uint before = subgroupExclusiveAdd(entries);
-    uint total = subgroupAdd(entries);
-    uint first = 0u;
-    if (subgroupElect() && total != 0u) {
-        first = atomicAdd(list.count, total);
-        atomicMax(list.groups_x, (first + total + VOXEL_LIST_GROUP_SIZE - 1u) / VOXEL_LIST_GROUP_SIZE);
+    uint first;
+    SUBGROUP_ATOMIC_ADD(list.count, entries, first)
+    if (entries != 0u) {
+        atomicMax(list.groups_x, (first + entries + VOXEL_LIST_GROUP_SIZE - 1u) / VOXEL_LIST_GROUP_SIZE);
     }
-    return subgroupBroadcastFirst(first) + before;
+    return first;
 }
 #endif
 

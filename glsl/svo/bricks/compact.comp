@@ -6,11 +6,12 @@
 // invocation per voxel, dispatched indirectly from the list's head as in the dense grid
 // (gi/compact/compact.comp). Bricks of the static part (before
 // `counters.static_leaf_bricks`) keep the attributes their build wrote; later ones, given
-// in this build or frame (every brick, in a build), are written, and their radiance brick
-// zeroed, border included (the brick may have held another leaf last frame; voxel shading
-// writes only the listed voxels, the border transfer the border). The pools are not
-// cleared: clears of these 3D images ran at about 50 GB/s on an H100 (65 ms of the
-// depth-10 Sponza build), and only the bricks in use are ever read.
+// in this build or frame (every brick, in a build), are written, and their radiance
+// voxels zeroed (the brick may have held another leaf last frame; voxel shading writes
+// only the listed voxels, and the border transfer writes the border of every new brick
+// before the filter reads it). The pools are not cleared: clears of these 3D
+// images ran at about 50 GB/s on an H100 (65 ms of the depth-10 Sponza build), and only
+// the bricks in use are ever read.
 #define VOXELS_SVO
 #define VOXEL_LIST_WRITER
 #include "svo/octree/level.glsl"
@@ -23,17 +24,12 @@ layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform writeonly u
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D leaf_radiance;
 
 // Writes the means of `node`'s voxels into a brick given in this build or frame (and
-// zeroes its radiance brick); returns the mask of its voxels with fragments.
+// zeroes their radiance); returns the mask of its voxels with fragments.
 uint take_means(uint node) {
     uint brick = node_bricks[node];
     ivec3 origin = brick_origin(brick, counters.leaf_pool_side, SVO_ATTRIBUTE_BRICK);
     bool fresh = brick >= counters.static_leaf_bricks;
-    if (fresh) {
-        ivec3 radiance_origin = brick_origin(brick, counters.leaf_pool_side, SVO_RADIANCE_BRICK);
-        for (int i = 0; i < 64; i++) {
-            imageStore(leaf_radiance, radiance_origin + ivec3(i & 3, (i >> 2) & 3, i >> 4), vec4(0.0));
-        }
-    }
+    ivec3 radiance_origin = brick_origin(brick, counters.leaf_pool_side, SVO_RADIANCE_BRICK) + 1;
     uint entry = node_children[node];
     uint listed = 0u;
     for (int i = 0; i < 8; i++) {
@@ -55,6 +51,7 @@ uint take_means(uint node) {
         imageStore(leaf_albedo, origin + k, uvec4(means[0]));
         imageStore(leaf_normal, origin + k, uvec4(means[1]));
         imageStore(leaf_emission, origin + k, uvec4(means[2]));
+        imageStore(leaf_radiance, radiance_origin + k, vec4(0.0));
     }
     return listed;
 }

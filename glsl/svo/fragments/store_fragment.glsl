@@ -9,17 +9,12 @@
 #include "svo/octree.glsl"
 
 #ifdef SUBGROUP_APPEND
-#extension GL_KHR_shader_subgroup_ballot : require
-// The compute voxelizer's lanes take their records with one atomic add per subgroup:
-// one per record serializes on the counter (Sponza's 12 M fragments at depth 10 took
-// 15 ms so on an H200, the rasterizer 7 ms).
+#include "gi/subgroup_add.glsl"
+// The compute voxelizer's lanes take their records together with their subgroup.
 uint append_fragment() {
-    uvec4 ballot = subgroupBallot(true);
-    uint first = 0u;
-    if (subgroupElect()) {
-        first = atomicAdd(counters.fragment_count, subgroupBallotBitCount(ballot));
-    }
-    return subgroupBroadcastFirst(first) + subgroupBallotExclusiveBitCount(ballot);
+    uint index;
+    SUBGROUP_ATOMIC_ADD(counters.fragment_count, 1u, index)
+    return index;
 }
 #else
 uint append_fragment() {

@@ -8,6 +8,7 @@
 // static brick and sums stay as built and the next frame finds them again. A pool that
 // runs out is reported in `counters.overflow`; the host grows it and builds again.
 #include "svo/octree/level.glsl"
+#include "gi/subgroup_add.glsl"
 
 void main() {
     uint node;
@@ -27,7 +28,8 @@ void main() {
     }
     uint brick;
     if (leaf) {
-        brick = atomicAdd(counters.leaf_bricks, 1u);
+        // All invocations here are leaves (the level is the push constant's).
+        SUBGROUP_ATOMIC_ADD(counters.leaf_bricks, 1u, brick)
         if (brick >= counters.leaf_brick_capacity) {
             atomicOr(counters.overflow, SVO_OVERFLOW_LEAF_BRICKS);
             brick = SVO_NO_BRICK;
@@ -43,7 +45,8 @@ void main() {
     if (leaf) {
         uint mask = entry & 0xffu;
         uint voxels = uint(bitCount(mask));
-        uint first = atomicAdd(counters.leaf_voxels, voxels);
+        uint first;
+        SUBGROUP_ATOMIC_ADD(counters.leaf_voxels, voxels, first)
         if (first + voxels > counters.leaf_voxel_capacity) {
             atomicOr(counters.overflow, SVO_OVERFLOW_LEAF_VOXELS);
             // No voxels: fill.comp skips the leaf (the build runs again).
