@@ -507,31 +507,30 @@ impl Dense {
                 volumes.static_sums.as_ref().unwrap_or(&volumes.sums).view,
             );
         bind_cone_samples(writer, &volumes.radiance, &volumes.directional, linear).apply();
-        // The sums start at zero; the compact pass zeroes them again after taking the
-        // means, for the next voxelization.
-        OneShot::new(ctx)?.run("zero voxel sums", |cmd| {
-            clear_to_zero(
-                ctx,
-                cmd,
+        // The volumes start at zero, once: the compact pass zeroes the sums after taking
+        // their means, and a voxel's attributes and radiance when it empties. They stay in
+        // GENERAL: written as storage, the radiance sampled by cones.
+        OneShot::new(ctx)?.run("zero voxel volumes", |cmd| {
+            let zeroed = [
                 &volumes.sums,
-                ImageUse::UNDEFINED,
-                ImageUse::COMPUTE_WRITE,
-            );
-            Ok(())
-        })?;
-        // The volumes stay in GENERAL: written as storage, the radiance sampled by cones.
-        to_compute_write(
-            ctx,
-            "gi volume layouts",
-            &[
                 &volumes.albedo,
                 &volumes.normal,
                 &volumes.emission,
                 &volumes.radiance,
                 &volumes.direct,
-                &volumes.directional,
-            ],
-        )?;
+            ];
+            for image in zeroed {
+                clear_to_zero(
+                    ctx,
+                    cmd,
+                    image,
+                    ImageUse::UNDEFINED,
+                    ImageUse::COMPUTE_WRITE,
+                );
+            }
+            Ok(())
+        })?;
+        to_compute_write(ctx, "gi volume layouts", &[&volumes.directional])?;
         let compact = compact::CompactPass::new(ctx, layouts, resolution)?;
         SetWriter::new(ctx, set)
             .buffer(

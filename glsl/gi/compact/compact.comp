@@ -1,14 +1,14 @@
 #version 460
 // Takes each voxel's attribute means from its fragment sums (gi/sums.glsl; with moving
 // meshes, this frame's sums plus the static meshes') into the albedo, normal and emission
-// volumes (zero for a voxel without fragments), zeroes this frame's sums for the next
-// voxelization and the voxel's radiance and direct light (injection writes those of the
-// listed voxels only), and lists the occupied voxels, so that voxel shading and bounces
-// run one invocation per occupied voxel instead of one per grid cell (a wall fills a
-// quarter to a half of the cells of the workgroups it crosses, and idle lanes cost as
-// much as busy ones). The list head doubles as the indirect dispatch arguments. Zeroing
-// here instead of clearing the images: clears and copies of these 3D images ran at about
-// 50 GB/s on an H100.
+// volumes, zeroes this frame's sums for the next voxelization and the voxel's radiance
+// and direct light (injection writes those of the listed voxels only); a voxel empty now
+// and before keeps its zeros untouched. It lists the occupied voxels, so that voxel
+// shading and bounces run one invocation per occupied voxel instead of one per grid cell
+// (a wall fills a quarter to a half of the cells of the workgroups it crosses, and idle
+// lanes cost as much as busy ones). The list head doubles as the indirect dispatch
+// arguments. Zeroing here instead of clearing the images: clears and copies of these 3D
+// images ran at about 50 GB/s on an H100.
 #include "gi/sums.glsl"
 #define VOXEL_LIST_WRITER
 #include "gi/voxel_list.glsl"
@@ -16,7 +16,7 @@
 layout(local_size_x = VOXEL_GROUP_SIZE, local_size_y = VOXEL_GROUP_SIZE, local_size_z = VOXEL_GROUP_SIZE) in;
 layout(set = SET_PASS, binding = BINDING_GI_SUMS, r32ui) uniform uimage3D voxel_sums;
 layout(set = SET_PASS, binding = BINDING_GI_STATIC_SUMS, r32ui) uniform readonly uimage3D static_sums;
-layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform writeonly uimage3D voxel_albedo;
+layout(set = SET_PASS, binding = BINDING_GI_ALBEDO, r32ui) uniform uimage3D voxel_albedo;
 layout(set = SET_PASS, binding = BINDING_GI_NORMAL, r32ui) uniform writeonly uimage3D voxel_normal;
 layout(set = SET_PASS, binding = BINDING_GI_EMISSION, r32ui) uniform writeonly uimage3D voxel_emission;
 layout(set = SET_PASS, binding = BINDING_GI_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance;
@@ -38,6 +38,10 @@ void main() {
     bool fresh = fresh_count != 0u;
     bool kept = kept_count != 0u;
     uint count = fresh_count + kept_count;
+    // Alpha counts the fragments: zero for a voxel that was empty.
+    if (count == 0u && imageLoad(voxel_albedo, voxel).r == 0u) {
+        return;
+    }
     uint means[3] = uint[3](0u, 0u, 0u);
     if (count != 0u) {
         for (uint a = 0u; a < 3u; a++) {
