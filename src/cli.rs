@@ -380,17 +380,68 @@ impl CommonArgs {
 }
 
 /// The built-in Cornell box in `assets/`: of the checkout `cargo run` runs from, else of
-/// the one the binary was built in (a build shared between checkouts may be either's).
+/// the one the binary was built in (a build shared between checkouts may be either's),
+/// else, for a binary copied or installed elsewhere, the copy of it that the binary
+/// carries, written to `$XDG_CACHE_HOME/voxcone/builtin` (or `~/.cache/...`, or the
+/// temporary directory). Where that cannot be written either, the checkout's path: the
+/// loader's error names it.
 pub fn default_scene() -> PathBuf {
-    std::env::var_os("CARGO_MANIFEST_DIR")
+    let in_checkout = std::env::var_os("CARGO_MANIFEST_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")))
-        .join("assets/cornell.toml")
+        .join("assets/cornell.toml");
+    if in_checkout.exists() {
+        return in_checkout;
+    }
+    let cache = std::env::var_os("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+        .unwrap_or_else(std::env::temp_dir);
+    write_builtin_scene(&cache.join("voxcone/builtin")).unwrap_or(in_checkout)
+}
+
+/// The built-in scene's files, as the binary carries them.
+const BUILTIN_SCENE: [(&str, &str); 3] = [
+    ("cornell.toml", include_str!("../assets/cornell.toml")),
+    ("cornell.obj", include_str!("../assets/cornell.obj")),
+    ("cornell.mtl", include_str!("../assets/cornell.mtl")),
+];
+
+/// Writes the built-in scene's files into `dir` (unless they are there already) and
+/// returns the path of its scene file.
+fn write_builtin_scene(dir: &std::path::Path) -> std::io::Result<PathBuf> {
+    std::fs::create_dir_all(dir)?;
+    for (name, text) in BUILTIN_SCENE {
+        let path = dir.join(name);
+        if std::fs::read_to_string(&path).ok().as_deref() != Some(text) {
+            std::fs::write(&path, text)?;
+        }
+    }
+    Ok(dir.join(BUILTIN_SCENE[0].0))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A binary away from its checkout loads the copy of the built-in scene it carries.
+    #[test]
+    fn builtin_scene_loads_from_the_copy_the_binary_carries() {
+        let dir = std::env::temp_dir().join(format!("voxcone-builtin-{}", std::process::id()));
+        let path = write_builtin_scene(&dir).unwrap();
+        let copy = crate::scene::Scene::load(&path, &Default::default()).unwrap();
+        let original = crate::scene::Scene::load(&default_scene(), &Default::default()).unwrap();
+        assert_eq!(copy.meshes.len(), original.meshes.len());
+        assert!(!copy.meshes.is_empty());
+        // Written again over an older copy.
+        std::fs::write(dir.join("cornell.obj"), "# stale").unwrap();
+        write_builtin_scene(&dir).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(dir.join("cornell.obj")).unwrap(),
+            BUILTIN_SCENE[1].1
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
 
     #[test]
     fn sizes_parse_and_bad_sizes_are_explained() {
