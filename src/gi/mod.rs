@@ -708,9 +708,12 @@ impl VoxelGi {
         let resolution = settings.voxels;
         let cones = settings.cones;
         check_voxels(resolution)?;
-        if !ctx.features.geometry_shader || !ctx.features.fragment_stores_and_atomics {
+        let rasterized = settings.voxelizer.on(ctx) == voxelize::Voxelizer::Raster;
+        if rasterized && !(ctx.features.geometry_shader && ctx.features.fragment_stores_and_atomics)
+        {
             bail!(
-                "voxel GI needs geometry shaders and fragment stores/atomics, which {} lacks",
+                "the rasterizing voxelizer needs geometry shaders and fragment stores/atomics, \
+                 which {} lacks: try --voxelizer compute",
                 ctx.device_name()
             );
         }
