@@ -22,7 +22,7 @@ pub enum Voxelizer {
     #[default]
     Auto,
     /// The hardware rasterizer, with a geometry shader (on lavapipe the much faster:
-    /// Sponza at 64^3 in 1.0 s against 106 s)
+    /// Sponza at 64^3 in 1.0 s against about 110 s)
     Raster,
     /// A compute shader, one workgroup per triangle (on GPUs that draw with few units,
     /// such as an H100, the faster)
