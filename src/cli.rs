@@ -132,7 +132,7 @@ pub struct CommonArgs {
     #[arg(long)]
     pub full_update: bool,
 
-    /// How the scene is voxelized (both give the same voxels)
+    /// How the scene is voxelized (both cover the same voxels)
     #[arg(long, value_enum, default_value_t)]
     pub voxelizer: crate::gi::voxelize::Voxelizer,
     /// Leave out the direct light.
