@@ -400,8 +400,8 @@ gpu_layout! {
         uint static_leaf_bricks,
         /// Nodes each update list holds.
         uint update_capacity,
-        /// Unused.
-        uint pad3,
+        /// 1: voxel shading and the bounces store every change of a leaf's radiance, however small (the frame after a build, which computes every bounce from scratch, as the dense grid does); 0: only changes beyond `RADIANCE_CHANGE` (later frames, so that converged bounces stop).
+        uint exact_stores,
         /// Unused.
         uint pad4,
     }

@@ -29,15 +29,20 @@ fn svo_agrees_with_dense_grid() {
     let between = flip(&dense, &svo);
     let (flip_svo, flip_dense) = (flip(&reference, &svo), flip(&reference, &dense));
     eprintln!(
-        "LDR-FLIP svo vs dense {between:.4}; against cornell_point: svo {flip_svo:.4}, \
-         dense {flip_dense:.4}"
+        "LDR-FLIP svo vs dense {between:.6}; against cornell_point: svo {flip_svo:.7}, \
+         dense {flip_dense:.7}"
     );
-    // Measured 0.0019 (0.0087 before the octree read neighbouring bricks half a voxel
-    // outside a node, as the dense sampler does; the issue asks for 0.03); 0.1325 and
-    // 0.1324.
-    assert!(between <= 0.005, "svo and dense differ: LDR-FLIP {between}");
+    // Measured 1.7e-5 to 2.1e-5, and 0.1325243-0.1325253 against 0.1325251: both average the same
+    // exact fragment sums, and the frame after the octree's build stores its radiance
+    // exactly, as the dense grid does. (0.0019 while the dense grid kept a running RGBA8
+    // average and the octree stored only changes beyond 1/512; the issue asks for 0.03.)
+    // What is left is the sampler's rounding where the bricks land (see below).
     assert!(
-        flip_svo <= flip_dense + 0.005,
+        between <= 0.0005,
+        "svo and dense differ: LDR-FLIP {between}"
+    );
+    assert!(
+        flip_svo <= flip_dense + 1e-5,
         "svo {flip_svo} worse than dense {flip_dense}"
     );
 }

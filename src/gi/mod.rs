@@ -1011,6 +1011,9 @@ impl VoxelGi {
             timer.end(cmd);
             filter(&self.voxels, timer, "bounce filter");
         }
+        if let Voxels::Octree(svo) = &self.voxels {
+            svo.record_end_of_bounces(cmd);
+        }
         Ok(())
     }
 

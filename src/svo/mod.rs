@@ -179,6 +179,9 @@ pub struct SvoGi {
     region: Option<[[i32; 3]; 2]>,
     /// The next filter runs over every node (the first after a build).
     filter_all: std::cell::Cell<bool>,
+    /// The counters ask for exact radiance stores (`SvoCounters::exact_stores`, set by a
+    /// build) until the end of the next frame's bounces.
+    exact_stores: std::cell::Cell<bool>,
     /// `--full-update`: every mesh is voxelized again every frame too.
     full_update: bool,
     /// The carry table the current frame writes.
@@ -262,6 +265,7 @@ impl SvoGi {
             moved: Aabb::EMPTY,
             region: None,
             filter_all: std::cell::Cell::new(true),
+            exact_stores: std::cell::Cell::new(true),
             moving: scene.has_moving_meshes(),
             full_update,
             carry_parity: 0,
@@ -311,6 +315,21 @@ impl SvoGi {
         self.bounce_gate.dispatch(cmd, &sets, [1, 1, 1]);
         octree::compute_to_indirect(&self.ctx, cmd);
         (self.pools.updates.raw, pools::BOUNCE_DISPATCH_OFFSET)
+    }
+
+    /// After a frame's bounces: the frames after the one that follows a build store only
+    /// changes beyond the tolerance, so that converged bounces stop.
+    pub fn record_end_of_bounces(&self, cmd: vk::CommandBuffer) {
+        if self.exact_stores.replace(false) {
+            update_buffer(
+                &self.ctx,
+                cmd,
+                self.counters.raw,
+                std::mem::offset_of!(SvoCounters, exact_stores) as u64,
+                bytemuck::bytes_of(&0u32),
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+            );
+        }
     }
 
     /// Filters the leaf radiance up the tree, bottom-up, with the bricks' borders copied
@@ -460,6 +479,7 @@ impl SvoGi {
         }
         let (counters, levels) = built.context("the octree phase did not run")?;
         self.filter_all.set(true);
+        self.exact_stores.set(true);
         self.moved = draw.scene.moving_bounds(draw.time_s);
         // Nothing carried yet.
         let carry = self.pools.carry.raw;
@@ -678,6 +698,7 @@ impl SvoGi {
             fragment_base: base,
             static_node_count: part.nodes,
             static_leaf_bricks: part.leaf_bricks,
+            exact_stores: u32::from(!part.saved),
             update_capacity: c.nodes,
             ..Default::default()
         };
