@@ -5,6 +5,7 @@ use std::sync::Arc;
 use ash::vk;
 
 use crate::frontend::{Offscreen, LDR_FORMAT};
+use crate::gi::voxelize::Voxelizer;
 use crate::gi::{ConeSettings, VoxelStructure};
 use crate::renderer::{GiSettings, OutputTarget, RenderSettings, Renderer};
 use crate::scene::Scene;
@@ -23,6 +24,14 @@ pub fn gi_settings(voxels: u32, structure: VoxelStructure, full_update: bool) ->
         }),
         ..Default::default()
     }
+}
+
+/// `settings` with the GI voxelized by `voxelizer`.
+pub fn with_voxelizer(mut settings: RenderSettings, voxelizer: Voxelizer) -> RenderSettings {
+    if let Some(gi) = settings.gi.as_mut() {
+        gi.voxelizer = voxelizer;
+    }
+    settings
 }
 
 /// Renders 64x64 frames of `scene`, one at each of `times`, with validation on (its

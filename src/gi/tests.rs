@@ -11,7 +11,7 @@ use super::{Grid, Volume};
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
-use crate::testing::{gi_settings, moving_cube_scene, render_frames};
+use crate::testing::{gi_settings, moving_cube_scene, render_frames, with_voxelizer};
 use crate::vk::Context;
 
 /// Renders 64x64 frames of `scene` with `--gi dense --voxels n`, one at each time,
@@ -41,8 +41,10 @@ fn check_voxelization(scene: Scene, n: u32) {
 
 fn check_voxelization_by(scene: Scene, n: u32, voxelizer: Voxelizer) {
     let triangles = reference::world_triangles(&scene);
-    let mut settings = gi_settings(n, super::VoxelStructure::Dense, false);
-    settings.gi.as_mut().unwrap().voxelizer = voxelizer;
+    let settings = with_voxelizer(
+        gi_settings(n, super::VoxelStructure::Dense, false),
+        voxelizer,
+    );
     let (ctx, renderer) = render_frames(scene, settings, &[0.0]);
     let grid: Grid = renderer.gi().unwrap().grid;
     let gpu = occupancy(&renderer);
@@ -160,7 +162,7 @@ fn filter_matches_cpu() {
 /// A mesh moving across the Cornell box leaves no voxel behind: after frames at several
 /// times, with the static voxels kept from the first frame, the voxels (occupancy and
 /// albedo) equal a fresh voxelization at the last time and a full re-voxelization of
-/// every frame.
+/// every frame, with either voxelizer.
 #[test]
 fn moving_mesh_leaves_no_voxels_behind() {
     let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
@@ -168,13 +170,24 @@ fn moving_mesh_leaves_no_voxels_behind() {
     };
     let dir = std::env::temp_dir().join(format!("voxcone-moving-{}", std::process::id()));
     let scene = moving_cube_scene(&cornell, &dir, false);
+    for voxelizer in [Voxelizer::Raster, Voxelizer::Compute] {
+        check_moving_mesh(scene.clone(), voxelizer);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+fn check_moving_mesh(scene: Scene, voxelizer: Voxelizer) {
+    let render_at = |scene: Scene, times: &[f32], full_update| {
+        let settings = gi_settings(32, super::VoxelStructure::Dense, full_update);
+        render_frames(scene, with_voxelizer(settings, voxelizer), times)
+    };
     let times = [0.0, 0.5, 1.0];
-    let (ctx, moved) = render_at(scene.clone(), 32, &times, false);
+    let (ctx, moved) = render_at(scene.clone(), &times, false);
     let moved_voxels = occupancy(&moved);
-    let (_, fresh) = render_at(scene.clone(), 32, &[1.0], false);
+    let (_, fresh) = render_at(scene.clone(), &[1.0], false);
     let fresh_voxels = occupancy(&fresh);
-    let (_, full) = render_at(scene.clone(), 32, &times, true);
-    let (_, start) = render_at(scene, 32, &[0.0], false);
+    let (_, full) = render_at(scene.clone(), &times, true);
+    let (_, start) = render_at(scene, &[0.0], false);
     let start_voxels = occupancy(&start);
     assert_ne!(start_voxels, fresh_voxels, "the cube did not move");
     assert_eq!(
@@ -191,7 +204,6 @@ fn moving_mesh_leaves_no_voxels_behind() {
         "albedo differs from --full-update"
     );
     assert_eq!(ctx.validation_messages(), 0);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Static geometry is voxelized once: later frames only shade it (a moving light needs

@@ -11,7 +11,9 @@ use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel};
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
-use crate::testing::{gi_settings, moving_cube_scene, render_frames, render_frames_with};
+use crate::testing::{
+    gi_settings, moving_cube_scene, render_frames, render_frames_with, with_voxelizer,
+};
 use crate::vk::Context;
 
 /// A renderer whose octree of `scene` is built at `depth`, after `frames` frames.
@@ -281,12 +283,12 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
 fn check_octree(scene: Scene, depth: u32, voxelizer: Voxelizer) {
     let triangles = reference::world_triangles(&scene);
     let solid = reference::world_triangles_where(&scene, |m| m.coverage_texture.is_none());
-    let mut settings = gi_settings(
+    let settings = gi_settings(
         1 << depth,
         VoxelStructure::Octree { capacities: None },
         false,
     );
-    settings.gi.as_mut().unwrap().voxelizer = voxelizer;
+    let settings = with_voxelizer(settings, voxelizer);
     let (ctx, renderer) = render_frames(scene, settings, &[]);
     let svo = renderer.gi().unwrap().octree().unwrap();
     let d = download(svo);
@@ -710,7 +712,8 @@ fn leaf_snapshot(r: &Renderer) -> (Vec<u32>, Vec<([u32; 3], u32)>) {
 /// at the last time and a full rebuild (`--full-update`), and differs from the first
 /// time's. Its structure matches a CPU octree of the static and moving fragments, and
 /// the static part is as its build left it: the same runs of nodes per level, and every
-/// static node's entry restored but where the moving cube reached it.
+/// static node's entry restored but where the moving cube reached it. With either
+/// voxelizer.
 #[test]
 fn moving_mesh_leaves_no_nodes_behind() {
     let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
@@ -718,12 +721,19 @@ fn moving_mesh_leaves_no_nodes_behind() {
     };
     let dir = std::env::temp_dir().join(format!("voxcone-svo-moving-{}", std::process::id()));
     let scene = moving_cube_scene(&cornell, &dir, false);
+    for voxelizer in [Voxelizer::Raster, Voxelizer::Compute] {
+        check_moving_mesh(scene.clone(), voxelizer);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+fn check_moving_mesh(scene: Scene, voxelizer: Voxelizer) {
     let structure = VoxelStructure::Octree { capacities: None };
-    let settings = gi_settings(64, structure, false);
-    let (ctx, moved) = render_frames(scene.clone(), settings.clone(), &[0.0, 0.5, 1.0]);
-    let (_, fresh) = render_frames(scene.clone(), settings.clone(), &[1.0]);
-    let (_, full) = render_frames(scene.clone(), gi_settings(64, structure, true), &[1.0]);
-    let (_, start) = render_frames(scene, settings, &[0.0]);
+    let settings = |full_update| with_voxelizer(gi_settings(64, structure, full_update), voxelizer);
+    let (ctx, moved) = render_frames(scene.clone(), settings(false), &[0.0, 0.5, 1.0]);
+    let (_, fresh) = render_frames(scene.clone(), settings(false), &[1.0]);
+    let (_, full) = render_frames(scene.clone(), settings(true), &[1.0]);
+    let (_, start) = render_frames(scene, settings(false), &[0.0]);
 
     let svo = moved.gi().unwrap().octree().unwrap();
     let d = download(svo);
@@ -797,7 +807,6 @@ fn moving_mesh_leaves_no_nodes_behind() {
         );
     }
     assert_eq!(ctx.validation_messages(), 0);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `--full-update` voxelizes every mesh and rebuilds the octree every frame: the same
