@@ -321,6 +321,13 @@ impl SvoGi {
     /// changes beyond the tolerance, so that converged bounces stop.
     pub fn record_end_of_bounces(&self, cmd: vk::CommandBuffer) {
         if self.exact_stores.replace(false) {
+            // The bounces and the filter read the counters until now.
+            stage_barrier(
+                &self.ctx,
+                cmd,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+            );
             update_buffer(
                 &self.ctx,
                 cmd,
