@@ -275,7 +275,7 @@ impl Volumes {
             desc.extent.depth = layout::VOXEL_SUM_WORDS.div_ceil(2) * n;
             Image::new(ctx, name, desc)
         };
-        // TRANSFER_DST: cleared when the voxels change.
+        // TRANSFER_DST: zeroed once, when created.
         let radiance_usage = vk::ImageUsageFlags::STORAGE
             | vk::ImageUsageFlags::SAMPLED
             | vk::ImageUsageFlags::TRANSFER_SRC

@@ -20,7 +20,12 @@ struct ProjectedTriangle {
     // The triangle's depth extent in voxels.
     vec2 depth_range;
     uint axis;
+    // Twice the projection's area (pixels², positive: counter-clockwise).
+    float area;
 };
+
+// A projection without area: the rasterizer draws nothing of it.
+const float DEGENERATE_AREA = 1e-12;
 
 // Grid coordinates with the dominant axis moved to z.
 vec3 swizzle(vec3 g, uint axis) {
@@ -55,6 +60,8 @@ ProjectedTriangle project_triangle(vec3 world[3]) {
     t.bounds = vec4(min(min(t.q[0].xy, t.q[1].xy), t.q[2].xy) - 0.5,
                     max(max(t.q[0].xy, t.q[1].xy), t.q[2].xy) + 0.5);
     t.depth_range = vec2(min(min(t.q[0].z, t.q[1].z), t.q[2].z), max(max(t.q[0].z, t.q[1].z), t.q[2].z));
+    vec3 q0 = t.q[0], q1 = t.q[1], q2 = t.q[2];
+    t.area = (q1.x - q0.x) * (q2.y - q0.y) - (q1.y - q0.y) * (q2.x - q0.x);
     return t;
 }
 
@@ -62,11 +69,10 @@ ProjectedTriangle project_triangle(vec3 world[3]) {
 // the triangle; a degenerate projection weighs vertex q[i] alone at q[i].
 vec3 projected_weights(ProjectedTriangle t, vec2 v, int i) {
     vec3 q0 = t.q[0], q1 = t.q[1], q2 = t.q[2];
-    float area = (q1.x - q0.x) * (q2.y - q0.y) - (q1.y - q0.y) * (q2.x - q0.x);
     vec3 bary = vec3(i == 0, i == 1, i == 2);
-    if (abs(area) >= 1e-12) {
-        float b1 = ((v.x - q0.x) * (q2.y - q0.y) - (v.y - q0.y) * (q2.x - q0.x)) / area;
-        float b2 = ((q1.x - q0.x) * (v.y - q0.y) - (q1.y - q0.y) * (v.x - q0.x)) / area;
+    if (abs(t.area) >= DEGENERATE_AREA) {
+        float b1 = ((v.x - q0.x) * (q2.y - q0.y) - (v.y - q0.y) * (q2.x - q0.x)) / t.area;
+        float b2 = ((q1.x - q0.x) * (v.y - q0.y) - (q1.y - q0.y) * (v.x - q0.x)) / t.area;
         bary = vec3(1.0 - b1 - b2, b1, b2);
     }
     vec3 w;

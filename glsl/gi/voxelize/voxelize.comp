@@ -39,9 +39,7 @@ void main() {
         uv[i] = vec2(vertex_data[v + 6u], vertex_data[v + 7u]);
     }
     ProjectedTriangle t = project_triangle(world);
-    // A triangle without area in its projection draws nothing, as in the rasterizer.
-    vec3 q0 = t.q[0], q1 = t.q[1], q2 = t.q[2];
-    if (abs((q1.x - q0.x) * (q2.y - q0.y) - (q1.y - q0.y) * (q2.x - q0.x)) < 1e-12) {
+    if (abs(t.area) < DEGENERATE_AREA) {
         return;
     }
     // The weights are affine in the pixel position: uv changes by these per pixel.
