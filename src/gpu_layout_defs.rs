@@ -138,7 +138,7 @@ gpu_layout! {
         /// Words of a voxel's fragment sums (dense grid and octree alike): albedo RGB, normal
         /// XYZ, emission RGB, then the fragment count (`glsl/gi/sums.glsl`).
         VOXEL_SUM_WORDS = 10;
-        /// SVO passes (set 2): the light each leaf voxel gathered in the last frame, kept across an octree rebuilt around moving meshes (which assigns new bricks): two hash tables of `carry_capacity` entries (key = voxel x | y << 10 | z << 20, plus 1; then the RGB floats), `uint[]` storage buffer.
+        /// SVO passes (set 2): the light each leaf voxel in a new brick gathered in the last frame, for the same voxel in the next frame's octree rebuilt around moving meshes (which gives it a new brick again): two hash tables of `carry_capacity` entries (key = voxel x | y << 10 | z << 20, plus 1; then the RGB floats), `uint[]` storage buffer.
         BINDING_SVO_CARRY = 29;
         /// SVO passes (set 2): the static part's child entries as the static build left them (Dřínovský 2013, 5.7): each frame restores them, and a static leaf that a moving mesh's fragments reach reads its own voxels' mask and sums from here, `uint[]` storage buffer.
         BINDING_SVO_STATIC_NODES = 30;
@@ -166,6 +166,8 @@ gpu_layout! {
         SVO_MAX_LEVELS = 16;
         /// Workgroup size of the passes over fragments and over a level's nodes.
         SVO_GROUP_SIZE = 64;
+        /// Workgroups along y of a dispatch over an update list: the border transfer, filter and spread passes share each node's work (texels, children, neighbours) among them, so that a short list still fills the GPU (1 on a CPU driver, where a workgroup costs more than the work it shares).
+        SVO_LIST_SLICES = 8;
         /// Bit of a node's child entry: the node is to be subdivided.
         SVO_SUBDIVIDE = 0x80000000;
         /// Bit of a leaf's coordinates (above x | y << 10 | z << 20): fragments of the current insertion reached the leaf; set by the flag pass, cleared by the alloc pass (the leaf's child entry has no bit to spare: its first sum takes bits 8-31, for up to 2^24 leaf voxels).
@@ -438,7 +440,7 @@ gpu_layout! {
     struct SvoUpdateList {
         /// Indirect dispatch over the list: workgroups of `SVO_GROUP_SIZE`.
         uint groups_x,
-        /// Indirect dispatch: 1.
+        /// Indirect dispatch: `SVO_LIST_SLICES` (1 on a CPU driver).
         uint groups_y,
         /// Indirect dispatch: 1.
         uint groups_z,
@@ -450,12 +452,16 @@ gpu_layout! {
     struct InjectPush {
         /// 1: store the radiance (0: a bounce rewrites it before the next filter).
         uint store_radiance,
+        /// Octree, 1: shade only the voxels whose light can have changed since they were last shaded (the lights and shadow views are as then): in new bricks, or with a light's path through the region.
+        uint cull,
+        /// Octree around moving meshes, 1: a stored radiance keeps the light the voxel's bounces gathered (0 in the frame after a build).
+        uint keep_indirect,
         /// Unused.
         uint pad0,
-        /// Unused.
-        uint pad1,
-        /// Unused.
-        uint pad2,
+        /// With `cull`: the first voxel (xyz) of the region where moving meshes were last frame or are now.
+        ivec4 region_min,
+        /// With `cull`: the last voxel (xyz) of that region (below `region_min`: none).
+        ivec4 region_max,
     }
 
     /// The bounce's dispatch in a static octree, after the update lists' heads: the voxel list's while anything changed since the last bounce, none once the bounces have converged.

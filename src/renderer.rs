@@ -451,6 +451,11 @@ impl Renderer {
         self.gi.as_ref()
     }
 
+    #[cfg(test)]
+    pub fn gi_mut(&mut self) -> Option<&mut VoxelGi> {
+        self.gi.as_mut()
+    }
+
     /// GPU memory of the voxel volumes or of the octree, by name (empty without GI).
     pub fn gi_memory_bytes(&self) -> Vec<(&'static str, u64)> {
         self.gi
@@ -645,7 +650,10 @@ impl Renderer {
 
         let gi = self.gi.as_mut().filter(|_| self.indirect);
         if let Some(gi) = gi {
-            gi.record_update(cmd, timer, &draw, frame.slot)?;
+            let mut lighting: Vec<u8> = bytemuck::cast_slice(&lights).to_vec();
+            lighting.extend_from_slice(bytemuck::cast_slice(&views));
+            lighting.push(u8::from(shadow_cones));
+            gi.record_update(cmd, timer, &draw, frame.slot, &lighting)?;
         }
 
         // With soft-shadow cones the GI's upsample pass shades every pixel.

@@ -24,6 +24,12 @@ uint shadow_view_for(GpuLight light, vec3 p) {
     return light.first_shadow_view + face;
 }
 
+// World size of one texel of shadow view `view` at p.
+float shadow_texel_world(ShadowView view, vec3 p) {
+    bool ortho = view.origin.w > 0.5;
+    return ortho ? view.texel_size : view.texel_size * distance(p, view.origin.xyz);
+}
+
 // Fraction of the light reaching p (normal n), PCF over (2 pcf_radius + 1)^2 bilinear
 // depth compares. `extra_offset` moves p further along n (voxel centres lie up to half a
 // voxel inside their surface).
@@ -32,10 +38,9 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset, int 
         return 1.0;
     }
     ShadowView view = shadow_views[shadow_view_for(light, p)];
-    bool ortho = view.origin.w > 0.5;
     // Normal offset of about two texels at p's distance keeps a surface from shadowing
     // itself without the light leaking through thin walls.
-    float texel_world = ortho ? view.texel_size : view.texel_size * distance(p, view.origin.xyz);
+    float texel_world = shadow_texel_world(view, p);
     vec4 clip = view.view_proj * vec4(p + n * (2.0 * texel_world + extra_offset), 1.0);
     vec3 ndc = clip.xyz / clip.w;
     vec2 uv = ndc.xy * 0.5 + 0.5;

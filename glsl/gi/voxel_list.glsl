@@ -75,4 +75,12 @@ bool listed_voxel(out ListedVoxel entry) {
 #endif
     return true;
 }
+
+#ifdef VOXELS_SVO
+// Whether the entry's brick was given out in this frame's insertion of moving meshes (with
+// `--full-update`, every brick): its radiance started from zero.
+bool fresh_brick(ListedVoxel entry) {
+    return counters.carry_capacity > 0u && entry.brick >= counters.static_leaf_bricks;
+}
+#endif
 #endif

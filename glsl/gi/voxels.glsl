@@ -17,6 +17,17 @@ uint pack_rgba8(vec4 v) {
     return u.x | (u.y << 8) | (u.z << 16) | (u.w << 24);
 }
 
+// A packed normal (xyz * 127.5 + 127.5) as a vector of length up to 1 (shorter where
+// the averaged normals disagree); `flip_normal` negates it exactly.
+vec3 unpack_normal(uint v) {
+    return (unpack_rgba8(v).xyz * 2.0 - 255.0) / 255.0;
+}
+
+// The packed normal turned around (each of x, y, z becomes 255 minus it), its alpha kept.
+uint flip_normal(uint v) {
+    return v ^ 0x00ffffffu;
+}
+
 // World position of the centre of voxel `v`.
 vec3 voxel_center(ivec3 v) {
     return gi.origin.xyz + (vec3(v) + 0.5) * gi.origin.w;

@@ -36,24 +36,18 @@ impl InjectPass {
         Ok(Self { pipeline, bounce })
     }
 
-    /// Shades every voxel of the occupied-voxel list (`list`, which holds the dispatch);
-    /// `store_radiance`: the radiance too, not only the direct light (false when a bounce
-    /// rewrites it before the next filter).
+    /// Shades the voxels of the occupied-voxel list (`list`, which holds the dispatch)
+    /// that `push` asks for: every one, or those whose light can have changed.
     pub fn record(
         &self,
         cmd: vk::CommandBuffer,
         frame_set: vk::DescriptorSet,
         gi_set: vk::DescriptorSet,
         list: vk::Buffer,
-        store_radiance: bool,
+        push: &InjectPush,
     ) {
         let sets = [(layout::SET_FRAME, frame_set), (layout::SET_PASS, gi_set)];
-        let push = InjectPush {
-            store_radiance: u32::from(store_radiance),
-            ..Default::default()
-        };
-        self.pipeline
-            .push(cmd, vk::ShaderStageFlags::COMPUTE, &push);
+        self.pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, push);
         self.pipeline.dispatch_indirect(cmd, &sets, list, 0);
     }
 

@@ -26,7 +26,7 @@ use ash::vk;
 use glam::Vec3;
 
 use crate::gbuffer::GBuffer;
-use crate::gpu_layout::{self as layout, GiUniforms};
+use crate::gpu_layout::{self as layout, GiUniforms, InjectPush};
 use crate::renderer::GiSettings;
 use crate::scene::{Aabb, Scene};
 use crate::scene_gpu::{GpuScene, SceneDraw};
@@ -463,6 +463,14 @@ pub struct VoxelGi {
     accumulate_bounces: bool,
     /// The directional volumes hold last frame's result (with its bounces).
     history: bool,
+    /// What voxel shading last ran with (`record_update`'s `lighting`).
+    lighting: Option<Vec<u8>>,
+    /// Tests: shade every voxel every frame (what culling must match).
+    #[cfg(test)]
+    pub(crate) shade_every_voxel: bool,
+    /// Tests: frames whose voxel shading culled.
+    #[cfg(test)]
+    pub(crate) culled_frames: u32,
     /// `ConeSettings::indirect_scale`.
     indirect_scale_setting: Option<u32>,
     /// The scale of the current screen targets.
@@ -789,6 +797,11 @@ impl VoxelGi {
             bounces: cones.bounces.max(1),
             accumulate_bounces: cones.accumulate_bounces && cones.bounces > 1,
             history: false,
+            lighting: None,
+            #[cfg(test)]
+            shade_every_voxel: false,
+            #[cfg(test)]
+            culled_frames: 0,
             indirect_scale_setting: cones.indirect_scale,
             indirect_scale: 1,
             low_res: None,
@@ -819,6 +832,14 @@ impl VoxelGi {
     }
 
     /// The octree, with `--gi svo`.
+    #[cfg(test)]
+    pub fn octree_mut(&mut self) -> Option<&mut SvoGi> {
+        match &mut self.voxels {
+            Voxels::Octree(svo) => Some(svo),
+            Voxels::Dense(_) => None,
+        }
+    }
+
     pub fn octree(&self) -> Option<&SvoGi> {
         match &self.voxels {
             Voxels::Octree(svo) => Some(svo),
@@ -933,12 +954,17 @@ impl VoxelGi {
     /// With moving meshes every frame inserts them into the octree's static part, and
     /// their bricks are assigned anew; the light its voxels gathered is carried over by voxel (`crate::svo`), so
     /// bounces still accumulate one per frame. `slot` is the frame's slot in flight.
+    ///
+    /// `lighting` holds everything voxel shading reads besides the voxels (the lights,
+    /// their shadow views, the shadow mode): while it stays the same, the octree shades
+    /// again only the voxels whose light moving meshes can have changed.
     pub fn record_update(
         &mut self,
         cmd: vk::CommandBuffer,
         timer: &mut GpuTimer,
         draw: &SceneDraw,
         slot: usize,
+        lighting: &[u8],
     ) -> Result<()> {
         let ctx = &self.ctx;
         let n = self.grid.resolution;
@@ -976,8 +1002,36 @@ impl VoxelGi {
         compute_to_compute(ctx, cmd);
         // Unless a bounce rewrites the radiance before the filter reads it.
         let filter_now = !self.history || rebuilt;
-        self.inject
-            .record(cmd, draw.frame_set, set, list, filter_now);
+        let lighting_changed = self.lighting.as_deref() != Some(lighting);
+        if lighting_changed {
+            self.lighting = Some(lighting.to_vec());
+        }
+        let mut push = InjectPush {
+            store_radiance: u32::from(filter_now),
+            ..Default::default()
+        };
+        let mut shade = true;
+        if let Voxels::Octree(svo) = &self.voxels {
+            // The frame after a build shades every voxel (the bricks hold no light yet).
+            let built = svo.just_built();
+            let cull = !built && !lighting_changed;
+            #[cfg(test)]
+            let cull = cull && !self.shade_every_voxel;
+            #[cfg(test)]
+            {
+                self.culled_frames += u32::from(cull);
+            }
+            push.cull = u32::from(cull);
+            push.keep_indirect = u32::from(svo.moving() && !built);
+            let [first, last] = svo.region().unwrap_or([[0; 3], [-1; 3]]);
+            push.region_min = [first[0], first[1], first[2], 0];
+            push.region_max = [last[0], last[1], last[2], 0];
+            // A still octree under the same light: no voxel's light changed.
+            shade = !cull || svo.moving();
+        }
+        if shade {
+            self.inject.record(cmd, draw.frame_set, set, list, &push);
+        }
         timer.end(cmd);
 
         // The dense filter is one pass; the octree's are timed per level.

@@ -33,7 +33,7 @@ impl Voxelizer {
     /// `Auto` resolved for the device.
     pub fn on(self, ctx: &Context) -> Self {
         match self {
-            Self::Auto if ctx.properties.device_type == vk::PhysicalDeviceType::CPU => Self::Raster,
+            Self::Auto if ctx.is_cpu() => Self::Raster,
             Self::Auto => Self::Compute,
             chosen => chosen,
         }

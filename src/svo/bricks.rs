@@ -27,43 +27,6 @@ fn list_offset(list: u32) -> vk::DeviceSize {
     u64::from(list) * std::mem::size_of::<SvoUpdateList>() as u64
 }
 
-/// Records emptying update lists `lists` of `updates` (a transfer, between compute
-/// passes).
-pub fn reset_update_lists(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    updates: vk::Buffer,
-    lists: &[u32],
-) {
-    let empty = SvoUpdateList {
-        groups_y: 1,
-        groups_z: 1,
-        ..Default::default()
-    };
-    stage_barrier(
-        ctx,
-        cmd,
-        vk::PipelineStageFlags2::ALL_COMMANDS,
-        vk::PipelineStageFlags2::ALL_TRANSFER,
-    );
-    for &list in lists {
-        unsafe {
-            ctx.device.cmd_update_buffer(
-                cmd,
-                updates,
-                list_offset(list),
-                bytemuck::bytes_of(&empty),
-            )
-        };
-    }
-    stage_barrier(
-        ctx,
-        cmd,
-        vk::PipelineStageFlags2::ALL_TRANSFER,
-        vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
-    );
-}
-
 /// Pushes `level` to `pipeline` and dispatches it over update list `list` of `updates`.
 fn dispatch_for_list(
     pipeline: &Pipeline,
@@ -89,6 +52,9 @@ pub struct BrickPasses {
     apron: Pipeline,
     spread: Pipeline,
     mark: Pipeline,
+    /// Workgroups that share each node of an update list (`SVO_LIST_SLICES`; 1 on a CPU
+    /// driver, where each workgroup costs more than the work it would share).
+    pub(super) list_slices: u32,
 }
 
 impl BrickPasses {
@@ -104,7 +70,50 @@ impl BrickPasses {
             apron: pipeline("svo apron", s::SVO_BRICKS_APRON_COMP)?,
             spread: pipeline("svo spread", s::SVO_BRICKS_SPREAD_COMP)?,
             mark: pipeline("svo mark", s::SVO_BRICKS_MARK_COMP)?,
+            list_slices: if ctx.is_cpu() {
+                1
+            } else {
+                layout::SVO_LIST_SLICES
+            },
         })
+    }
+
+    /// Records emptying update lists `lists` of `updates` (a transfer, between compute
+    /// passes).
+    pub fn reset_update_lists(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        updates: vk::Buffer,
+        lists: &[u32],
+    ) {
+        let empty = SvoUpdateList {
+            groups_y: self.list_slices,
+            groups_z: 1,
+            ..Default::default()
+        };
+        stage_barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::PipelineStageFlags2::ALL_TRANSFER,
+        );
+        for &list in lists {
+            unsafe {
+                ctx.device.cmd_update_buffer(
+                    cmd,
+                    updates,
+                    list_offset(list),
+                    bytemuck::bytes_of(&empty),
+                )
+            };
+        }
+        stage_barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags2::ALL_TRANSFER,
+            vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
+        );
     }
 
     /// One invocation per stored fragment; `counters` holds the dispatch at its start.
@@ -193,7 +202,7 @@ impl BrickPasses {
                 &[border]
             };
             timer.begin(cmd, &format!("spread {level}"));
-            reset_update_lists(ctx, cmd, updates, filled);
+            self.reset_update_lists(ctx, cmd, updates, filled);
             if level + 1 == depth {
                 mark(level);
             }

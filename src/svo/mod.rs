@@ -293,6 +293,18 @@ impl SvoGi {
         self.moving || self.full_update
     }
 
+    /// Whether the last build is not yet followed by a frame's bounces (voxel shading
+    /// then shades every voxel: no brick holds light yet).
+    pub fn just_built(&self) -> bool {
+        self.exact_stores.get()
+    }
+
+    /// Voxels (first, last) of the region where moving meshes were last frame or are
+    /// now.
+    pub fn region(&self) -> Option<[[i32; 3]; 2]> {
+        self.region
+    }
+
     /// The occupied leaf voxels: the indirect dispatch of voxel shading and bounces.
     pub fn voxel_list(&self) -> vk::Buffer {
         self.pools.voxel_list.raw
@@ -380,7 +392,8 @@ impl SvoGi {
             };
         }
         let all: Vec<u32> = (0..layout::SVO_UPDATE_LISTS).collect();
-        bricks::reset_update_lists(ctx, cmd, self.pools.updates.raw, &all);
+        self.bricks
+            .reset_update_lists(ctx, cmd, self.pools.updates.raw, &all);
     }
 
     /// The last build's report.
@@ -485,6 +498,12 @@ impl SvoGi {
             }
         }
         let (counters, levels) = built.context("the octree phase did not run")?;
+        // A frame's new bricks hold at most what the pools hold beyond the static part
+        // (more overflows, and the pools grow).
+        let fresh = self
+            .moving()
+            .then(|| self.pools.capacities.leaf_voxels - self.statics.leaf_voxels);
+        self.pools.size_carry(&self.ctx, set, fresh)?;
         self.filter_all.set(true);
         self.exact_stores.set(true);
         self.moved = draw.scene.moving_bounds(draw.time_s);
@@ -751,7 +770,8 @@ impl SvoGi {
         );
         if !part.saved {
             let all: Vec<u32> = (0..layout::SVO_UPDATE_LISTS).collect();
-            bricks::reset_update_lists(ctx, cmd, p.updates.raw, &all);
+            self.bricks
+                .reset_update_lists(ctx, cmd, p.updates.raw, &all);
             // The first bounce after a build runs.
             let first = SvoBounceDispatch {
                 groups_y: 1,

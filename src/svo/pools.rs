@@ -209,8 +209,9 @@ pub(super) struct Pools {
     pub(super) voxel_list: Buffer,
     /// Per leaf voxel, its fragments' attribute sums and count (`VOXEL_SUM_WORDS` words).
     pub(super) sums: Buffer,
-    /// Two tables of `carry_capacity` entries: the light each leaf voxel gathered, kept
-    /// across frames that insert meshes into the octree (only then: their bricks change).
+    /// Two tables of `carry_capacity` entries: the light each leaf voxel in a brick given
+    /// out by a frame's insertion of meshes gathered, for the same voxel next frame (its
+    /// brick is new again, or it is back in its static brick); sized by `size_carry`.
     pub(super) carry: Buffer,
     pub(super) carry_capacity: u32,
     /// The static part's child entries and bricks as its build left them (only with
@@ -226,6 +227,35 @@ pub(super) struct Pools {
     pub(super) in_general: std::cell::Cell<bool>,
 }
 
+/// A storage buffer of the pools (also copied and filled), within the device's limit.
+fn storage_buffer(
+    ctx: &Arc<Context>,
+    name: &str,
+    bytes: u64,
+    extra: vk::BufferUsageFlags,
+) -> Result<Buffer> {
+    let device_limit = u64::from(ctx.properties.limits.max_storage_buffer_range);
+    ensure!(
+        bytes <= device_limit,
+        "the SVO {name} needs {bytes} bytes, more than the device's largest storage buffer \
+         ({device_limit} bytes): use a smaller --octree-depth"
+    );
+    let storage = vk::BufferUsageFlags::STORAGE_BUFFER
+        | vk::BufferUsageFlags::TRANSFER_SRC
+        | vk::BufferUsageFlags::TRANSFER_DST;
+    Buffer::new(ctx, name, bytes, storage | extra, MemoryLocation::GpuOnly)
+}
+
+/// The two carry tables of `capacity` entries (4 words each).
+fn carry_tables(ctx: &Arc<Context>, capacity: u32) -> Result<Buffer> {
+    storage_buffer(
+        ctx,
+        "svo carry",
+        2 * 16 * u64::from(capacity.max(1)),
+        vk::BufferUsageFlags::empty(),
+    )
+}
+
 /// The update lists' heads, at the start of `Pools::updates`.
 pub(super) const UPDATE_HEADS_BYTES: u64 =
     layout::SVO_UPDATE_LISTS as u64 * std::mem::size_of::<SvoUpdateList>() as u64;
@@ -235,22 +265,10 @@ pub(super) const BOUNCE_DISPATCH_OFFSET: u64 = UPDATE_HEADS_BYTES;
 
 impl Pools {
     /// `moving`: moving meshes are inserted into the octree every frame; the static
-    /// part is kept aside, and the voxels' gathered light is carried from one frame to
-    /// the next.
+    /// part is kept aside.
     pub(super) fn new(ctx: &Arc<Context>, capacities: Capacities, moving: bool) -> Result<Self> {
-        let device_limit = u64::from(ctx.properties.limits.max_storage_buffer_range);
         let max_3d = ctx.properties.limits.max_image_dimension3_d;
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER
-            | vk::BufferUsageFlags::TRANSFER_SRC
-            | vk::BufferUsageFlags::TRANSFER_DST;
-        let buffer = |name: &str, bytes: u64, extra: vk::BufferUsageFlags| -> Result<Buffer> {
-            ensure!(
-                bytes <= device_limit,
-                "the SVO {name} needs {bytes} bytes, more than the device's largest storage \
-                 buffer ({device_limit} bytes): use a smaller --octree-depth"
-            );
-            Buffer::new(ctx, name, bytes, storage | extra, MemoryLocation::GpuOnly)
-        };
+        let buffer = |name: &str, bytes: u64, extra| storage_buffer(ctx, name, bytes, extra);
         let nodes = u64::from(capacities.nodes);
         let leaf_side = pool_side(capacities.leaf_bricks);
         let interior_side = pool_side(capacities.interior_bricks);
@@ -293,12 +311,6 @@ impl Pools {
             capacities.leaf_voxels
         );
         let list_words = 2 * u64::from(capacities.leaf_voxels);
-        // Half full at most, for short probes.
-        let carry_capacity = if moving {
-            (2 * capacities.leaf_voxels).next_power_of_two()
-        } else {
-            0
-        };
         Ok(Self {
             capacities,
             nodes: buffer("svo nodes", 4 * nodes, vk::BufferUsageFlags::empty())?,
@@ -331,12 +343,8 @@ impl Pools {
                 vk::BufferUsageFlags::empty(),
             )?,
             in_general: std::cell::Cell::new(false),
-            carry_capacity,
-            carry: buffer(
-                "svo carry",
-                2 * 16 * u64::from(carry_capacity.max(1)),
-                vk::BufferUsageFlags::empty(),
-            )?,
+            carry_capacity: 0,
+            carry: carry_tables(ctx, 0)?,
             static_children: buffer(
                 "svo static nodes",
                 if moving { 4 * nodes } else { 4 },
@@ -360,6 +368,30 @@ impl Pools {
                 vk::BufferUsageFlags::INDIRECT_BUFFER,
             )?,
         })
+    }
+
+    /// Sizes the carry tables for `voxels` leaf voxels in new bricks per frame at most (none
+    /// without moving meshes), half full at most for short probes, and writes them into
+    /// the GI set.
+    pub(super) fn size_carry(
+        &mut self,
+        ctx: &Arc<Context>,
+        set: vk::DescriptorSet,
+        voxels: Option<u32>,
+    ) -> Result<()> {
+        let capacity = voxels.map_or(0, |v| (2 * v.max(1)).next_power_of_two());
+        if capacity != self.carry_capacity {
+            self.carry = carry_tables(ctx, capacity)?;
+            self.carry_capacity = capacity;
+            SetWriter::new(ctx, set)
+                .buffer(
+                    layout::BINDING_SVO_CARRY,
+                    vk::DescriptorType::STORAGE_BUFFER,
+                    self.carry.raw,
+                )
+                .apply();
+        }
+        Ok(())
     }
 
     /// Writes the pools into the GI set: the octree's own bindings, and the bindings where

@@ -10,7 +10,7 @@ use crate::gi::{ConeSettings, VoxelStructure};
 use crate::gpu_layout::{self as layout, SvoCounters, SvoLevel};
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
-use crate::scene::{LoadOptions, Scene};
+use crate::scene::{Light, LightKind, LoadOptions, Scene};
 use crate::testing::{
     gi_settings, moving_cube_scene, render_frames, render_frames_with, with_voxelizer,
 };
@@ -554,17 +554,7 @@ fn bricks_filter_and_borders_match_cpu() {
     let d = download(svo);
     let p = &svo.pools;
     let read = |image: &crate::vk::Image| Pool {
-        texels: halves(
-            &crate::vk::read_back_image(
-                &svo.ctx,
-                image,
-                0,
-                image.desc.extent,
-                8,
-                super::RADIANCE_USE,
-            )
-            .unwrap(),
-        ),
+        texels: halves(&read_radiance_image(svo, image)),
         width: image.desc.extent.width,
         edge: image.desc.extent.height,
     };
@@ -684,25 +674,46 @@ fn bricks_filter_and_borders_match_cpu() {
     assert_eq!(ctx.validation_messages(), 0);
 }
 
+/// The occupied leaf voxels (with albedo) and the index of each one's texel in the leaf
+/// attribute images, sorted by voxel; with the albedo image.
+fn leaf_texels(svo: &SvoGi, d: &Downloaded) -> (Vec<([u32; 3], usize)>, Vec<u32>) {
+    let albedo = svo.download_leaf_attribute(0).unwrap();
+    let side = svo.pools.leaf_side;
+    let edge = side * layout::SVO_ATTRIBUTE_BRICK;
+    let mut voxels = Vec::new();
+    for (_, brick, c, k) in brick_voxels(d, svo.depth as usize - 1) {
+        let o = [brick % side, (brick / side) % side, brick / (side * side)];
+        let t: [u32; 3] = std::array::from_fn(|a| o[a] * layout::SVO_ATTRIBUTE_BRICK + k[a]);
+        let i = (t[0] + edge * (t[1] + edge * t[2])) as usize;
+        if albedo[i] != 0 {
+            voxels.push((std::array::from_fn(|a| 2 * c[a] + k[a]), i));
+        }
+    }
+    voxels.sort_unstable();
+    (voxels, albedo)
+}
+
+/// A radiance image of the octree (RGBA half floats), as downloaded.
+fn read_radiance_image(svo: &SvoGi, image: &crate::vk::Image) -> Vec<u8> {
+    crate::vk::read_back_image(
+        &svo.ctx,
+        image,
+        0,
+        image.desc.extent,
+        8,
+        super::RADIANCE_USE,
+    )
+    .unwrap()
+}
+
 /// Nodes per level, and the leaf voxels with their packed albedo (sorted), as they are
 /// after the last frame.
 #[allow(clippy::type_complexity)]
 fn leaf_snapshot(r: &Renderer) -> (Vec<u32>, Vec<([u32; 3], u32)>) {
     let svo = r.gi().unwrap().octree().unwrap();
     let d = download(svo);
-    let albedo = svo.download_leaf_attribute(0).unwrap();
-    let side = svo.pools.leaf_side;
-    let edge = side * layout::SVO_ATTRIBUTE_BRICK;
-    let mut voxels = Vec::new();
-    for (_, brick, c, k) in brick_voxels(&d, svo.depth as usize - 1) {
-        let o = [brick % side, (brick / side) % side, brick / (side * side)];
-        let t: [u32; 3] = std::array::from_fn(|a| o[a] * layout::SVO_ATTRIBUTE_BRICK + k[a]);
-        let word = albedo[(t[0] + edge * (t[1] + edge * t[2])) as usize];
-        if word != 0 {
-            voxels.push((std::array::from_fn::<u32, 3, _>(|a| 2 * c[a] + k[a]), word));
-        }
-    }
-    voxels.sort_unstable();
+    let (texels, albedo) = leaf_texels(svo, &d);
+    let voxels = texels.into_iter().map(|(v, i)| (v, albedo[i])).collect();
     let nodes: Vec<u32> = d.levels.iter().map(|l| l.len() as u32).collect();
     (nodes, voxels)
 }
@@ -809,6 +820,76 @@ fn check_moving_mesh(scene: Scene, voxelizer: Voxelizer) {
     assert_eq!(ctx.validation_messages(), 0);
 }
 
+/// Per occupied leaf voxel, its direct light (RGBA half floats), sorted by voxel.
+fn leaf_direct(r: &Renderer) -> Vec<([u32; 3], [u16; 4])> {
+    let svo = r.gi().unwrap().octree().unwrap();
+    let bytes = read_radiance_image(svo, &svo.pools.leaf_direct);
+    let direct: &[[u16; 4]] = bytemuck::cast_slice(&bytes);
+    let (texels, _) = leaf_texels(svo, &download(svo));
+    texels.into_iter().map(|(v, i)| (v, direct[i])).collect()
+}
+
+/// Around a moving mesh, voxel shading shades again only the voxels whose light can have
+/// changed (in new bricks, or with a light's path through where the mesh was or is),
+/// yet misses none: after frames of a cube moving through the box, lit by a point light
+/// (a cube of shadow maps) and a directional light through the open side, every leaf
+/// voxel's direct light equals what shading every voxel every frame gives, bit for bit;
+/// with shadow maps and with soft-shadow cones (a ray march through the voxels).
+#[test]
+fn shading_what_moving_meshes_change_misses_nothing() {
+    let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("voxcone-svo-cull-{}", std::process::id()));
+    let mut scene = moving_cube_scene(&cornell, &dir, false);
+    scene.lights.push(Light {
+        kind: LightKind::Point,
+        position: glam::Vec3::new(0.2, 1.5, 0.1),
+        intensity: glam::Vec3::splat(1.5),
+        orbit: None,
+    });
+    scene.lights.push(Light {
+        kind: LightKind::Directional {
+            direction: glam::Vec3::new(0.3, -0.5, -1.0).normalize(),
+        },
+        position: glam::Vec3::ZERO,
+        intensity: glam::Vec3::splat(2.0),
+        orbit: None,
+    });
+    let times = [0.0, 0.3, 0.6, 0.9, 1.2, 1.5];
+    for shadow_cones in [false, true] {
+        let mut settings = gi_settings(64, VoxelStructure::Octree { capacities: None }, false);
+        if let Some(gi) = &mut settings.gi {
+            gi.shadow_cones = shadow_cones;
+        }
+        let run = |every: bool| {
+            render_frames_with(scene.clone(), settings.clone(), &times, |r, _| {
+                r.gi_mut().unwrap().shade_every_voxel = every;
+            })
+        };
+        let (ctx, culled) = run(false);
+        let (_, every) = run(true);
+        assert_eq!(
+            culled.gi().unwrap().culled_frames as usize,
+            times.len() - 1,
+            "voxel shading culled in every frame after the first"
+        );
+        let (a, b) = (leaf_direct(&culled), leaf_direct(&every));
+        assert_eq!(a.len(), b.len());
+        let lit = b.iter().filter(|(_, t)| t[..3] != [0; 3]).count();
+        let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+        eprintln!(
+            "shadow cones {shadow_cones}: {differ} of {} leaf voxels' direct light differ ({lit} \
+             lit)",
+            b.len()
+        );
+        assert!(lit > b.len() / 4);
+        assert_eq!(differ, 0, "culled voxel shading missed a change");
+        assert_eq!(ctx.validation_messages(), 0);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// `--full-update` voxelizes every mesh and rebuilds the octree every frame: the same
 /// octree as the build that keeps it.
 #[test]
@@ -844,15 +925,7 @@ fn carried_light_converges_to_all_bounces() {
         let svo = r.gi().unwrap().octree().unwrap();
         let d = download(svo);
         let image = &svo.pools.leaf_radiance;
-        let bytes = crate::vk::read_back_image(
-            &svo.ctx,
-            image,
-            0,
-            image.desc.extent,
-            8,
-            super::RADIANCE_USE,
-        )
-        .unwrap();
+        let bytes = read_radiance_image(svo, image);
         let pool = Pool {
             texels: halves(&bytes),
             width: image.desc.extent.width,
@@ -883,33 +956,43 @@ fn carried_light_converges_to_all_bounces() {
 
 /// After frames of `scene` at `times` (with `before` run ahead of each), the levels the
 /// update lists filtered (and every brick's border) equal what a full filter of the
-/// leaves as stored gives, bit for bit.
+/// leaves as stored gives, bit for bit; with each node's work shared by one workgroup
+/// (as on a CPU driver) and by `SVO_LIST_SLICES` (as on a GPU).
 fn check_update_lists(
     scene: Scene,
     times: &[f32],
     bounces: u32,
-    before: impl FnMut(&mut Renderer, usize),
+    mut before: impl FnMut(&mut Renderer, usize),
     what: &str,
+) {
+    for slices in [1, layout::SVO_LIST_SLICES] {
+        check_update_lists_sliced(scene.clone(), times, bounces, &mut before, what, slices);
+    }
+}
+
+fn check_update_lists_sliced(
+    scene: Scene,
+    times: &[f32],
+    bounces: u32,
+    before: &mut impl FnMut(&mut Renderer, usize),
+    what: &str,
+    slices: u32,
 ) {
     let mut settings = gi_settings(64, VoxelStructure::Octree { capacities: None }, false);
     if let Some(gi) = &mut settings.gi {
         gi.cones.bounces = bounces;
     }
-    let (ctx, renderer) = render_frames_with(scene, settings, times, before);
+    let what = format!("{what}, {slices} workgroups a node");
+    let (ctx, renderer) = render_frames_with(scene, settings, times, |r, i| {
+        let svo = r.gi_mut().unwrap().octree_mut().unwrap();
+        svo.bricks.list_slices = slices;
+        before(r, i);
+    });
     let gi = renderer.gi().unwrap();
     let svo = gi.octree().unwrap();
     let images = || {
-        [&svo.pools.leaf_radiance, &svo.pools.directional].map(|image| {
-            crate::vk::read_back_image(
-                &svo.ctx,
-                image,
-                0,
-                image.desc.extent,
-                8,
-                super::RADIANCE_USE,
-            )
-            .unwrap()
-        })
+        [&svo.pools.leaf_radiance, &svo.pools.directional]
+            .map(|image| read_radiance_image(svo, image))
     };
     let listed = images();
     svo.full_filter(renderer.first_frame_set(), gi.set())

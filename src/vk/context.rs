@@ -99,6 +99,12 @@ const NO_DEVICE_HELP: &str = "install a Vulkan driver: on Debian/Ubuntu `apt-get
      (package vulkan-tools) lists what the loader finds";
 
 impl Context {
+    /// Whether the device is a CPU driver (lavapipe): there each workgroup costs more
+    /// than a GPU's idle lanes, and some passes pick other strategies.
+    pub fn is_cpu(&self) -> bool {
+        self.properties.device_type == vk::PhysicalDeviceType::CPU
+    }
+
     pub fn new(options: &ContextOptions) -> Result<Arc<Self>> {
         // SAFETY: loading the system Vulkan loader; failure is reported, not assumed.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| {

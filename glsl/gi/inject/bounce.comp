@@ -24,14 +24,14 @@ void main() {
     }
     ivec3 voxel = entry.texel;
     vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, voxel).r);
-    vec3 n = unpack_rgba8(imageLoad(voxel_normal, voxel).r).xyz / 255.0 * 2.0 - 1.0;
+    vec3 n = unpack_normal(imageLoad(voxel_normal, voxel).r);
     n = length(n) > 0.2 ? normalize(n) : vec3(0.0, 1.0, 0.0);
     vec3 p = voxel_center(entry.voxel);
     float offset = 1.5 * gi.origin.w;
     vec3 gathered = gather_diffuse(p, p + n * offset, n, BOUNCE_CONES, 1.0, false).rgb;
     vec4 direct = imageLoad(voxel_direct, voxel);
 #ifdef VOXELS_SVO
-    if (counters.carry_capacity > 0u) {
+    if (fresh_brick(entry)) {
         carry_store(uvec3(entry.voxel), gathered);
     }
 #endif

@@ -7,7 +7,10 @@
 // a voxel is wider than the PCF kernel), or with soft-shadow cones, which make the
 // shadow maps unnecessary, from a ray marched through the voxels towards the light.
 // With VOXELS_SVO the voxels are the octree's leaf voxels, in their bricks. The radiance
-// is stored only where a bounce does not rewrite it before the next filter.
+// is stored only where a bounce does not rewrite it before the next filter. Around
+// moving meshes (`push.cull`) only the voxels whose light can have changed are shaded
+// again: those in bricks given out this frame, and those a light reaches past where the
+// moving meshes were or are (`push.region_*`); the others keep their light.
 #include "common/frame.glsl"
 #include "common/direct_light.glsl"
 #include "gi/voxels.glsl"
@@ -60,6 +63,49 @@ float voxel_attenuation(vec3 n, vec3 l) {
     return dot(w, d);
 }
 
+#ifdef VOXELS_SVO
+// Whether the segment from p along the unit vector d, up to `dist`, meets the box
+// [lo, hi].
+bool segment_meets_box(vec3 p, vec3 d, float dist, vec3 lo, vec3 hi) {
+    vec3 inverse = 1.0 / mix(d, vec3(1e-12), lessThan(abs(d), vec3(1e-12)));
+    vec3 t0 = (lo - p) * inverse;
+    vec3 t1 = (hi - p) * inverse;
+    vec3 near = min(t0, t1);
+    vec3 far = max(t0, t1);
+    float enter = max(max(near.x, near.y), max(near.z, 0.0));
+    float exit = min(min(far.x, far.y), min(far.z, dist));
+    return enter <= exit;
+}
+
+// Whether the direct light of the voxel at p can differ from when it was last shaded
+// (the lights and shadow views are the same): only where the path to a light passes
+// the region where moving meshes were or are. The region grows by what the lookups
+// reach beyond that path: the shadow lookup's normal offset (two texels and half a
+// voxel) and its bilinear taps (a texel and a half), or the voxel ray-march's start
+// two voxels out and its cells around the ray; at p's distance a shadow texel is at
+// least as wide as where the path meets the region.
+bool light_may_change(vec3 p) {
+    float voxel = gi.origin.w;
+    vec3 lo = gi.origin.xyz + vec3(push.region_min.xyz) * voxel;
+    vec3 hi = gi.origin.xyz + vec3(push.region_max.xyz + 1) * voxel;
+    if (any(greaterThan(lo, hi))) {
+        return false;
+    }
+    for (uint i = 0u; i < frame.light_count; i++) {
+        GpuLight light = lights[i];
+        vec3 l;
+        float dist;
+        light_arriving(light, p, l, dist);
+        float texel = light.shadow_view_count == 0u ? 0.0 : shadow_texel_world(shadow_views[shadow_view_for(light, p)], p);
+        float margin = 4.0 * voxel + 4.0 * texel;
+        if (segment_meets_box(p, l, dist, lo - margin, hi + margin)) {
+            return true;
+        }
+    }
+    return false;
+}
+#endif
+
 // Irradiance at the voxel p on its side with (averaged) normal n from one light,
 // shadowed.
 vec3 voxel_irradiance(GpuLight light, vec3 p, vec3 n) {
@@ -79,17 +125,24 @@ void main() {
         return;
     }
     ivec3 voxel = entry.texel;
+    vec3 p = voxel_center(entry.voxel);
+#ifdef VOXELS_SVO
+    bool fresh = fresh_brick(entry);
+    if (push.cull != 0u && !fresh && !light_may_change(p)) {
+        return;
+    }
+#endif
     vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, voxel).r);
     vec3 rho = albedo.rgb / 255.0;
-    vec4 packed_normal = unpack_rgba8(imageLoad(voxel_normal, voxel).r);
-    vec3 n = packed_normal.xyz / 255.0 * 2.0 - 1.0;
+    uint packed_normal = imageLoad(voxel_normal, voxel).r;
+    vec3 n = unpack_normal(packed_normal);
     float len = length(n);
     // Opposite normals averaged in one voxel cancel; such a voxel faces every way.
     n = len > 0.2 ? n / len : vec3(0.0, 1.0, 0.0);
-    vec3 p = voxel_center(entry.voxel);
     // Surfaces are two-sided: the voxel keeps the face that receives more light (emitters
     // their winding face), and its normal is turned to that face so that the filter
-    // shows this radiance only to cones that look at the face.
+    // shows this radiance only to cones that look at the face. Turned exactly, so that
+    // shading the voxel again gives the same light.
     vec3 front = vec3(0.0);
     vec3 back = vec3(0.0);
     for (uint i = 0u; i < frame.light_count; i++) {
@@ -99,23 +152,29 @@ void main() {
     vec3 emission = unpack_rgba8(imageLoad(voxel_emission, voxel).r).rgb / 255.0 * gi.emission_range;
     bool back_lit = dot(back, vec3(1.0)) > dot(front, vec3(1.0)) && all(equal(emission, vec3(0.0)));
     vec3 e = len > 0.2 ? (back_lit ? back : front) : front + back;
-    if (len > 0.2) {
-        vec3 lit = back_lit ? -n : n;
-        imageStore(voxel_normal, voxel, uvec4(pack_rgba8(vec4((lit * 0.5 + 0.5) * 255.0, packed_normal.a))));
+    if (len > 0.2 && back_lit) {
+        imageStore(voxel_normal, voxel, uvec4(flip_normal(packed_normal)));
     }
     vec4 radiance = vec4(rho / PI * e + emission, 1.0);
 #ifdef VOXELS_SVO
+    vec4 direct_before = imageLoad(voxel_direct, voxel);
     // A light that moved: the bounces must run again (svo/bricks/bounce_dispatch.comp).
-    if (radiance_changed(radiance, imageLoad(voxel_direct, voxel))) {
+    if (radiance_changed(radiance, direct_before)) {
         bounce_dispatch.changed = 1u;
     }
 #endif
     imageStore(voxel_direct, voxel, radiance);
 #ifdef VOXELS_SVO
-    // An octree rebuilt around moving meshes starts from the light its voxels gathered
-    // last frame, as the dense grid's bounces start from last frame's filtered light.
-    if (counters.carry_capacity > 0u) {
-        radiance.rgb += rho * carry_load(uvec3(entry.voxel));
+    // Around moving meshes a voxel keeps the light its bounces gathered, as the dense
+    // grid's bounces start from last frame's filtered light: a voxel in a brick kept
+    // from last frame has it in its radiance beside the direct light it replaces; one in
+    // a new brick finds it in the carried light, by voxel.
+    if (push.keep_indirect != 0u && push.store_radiance != 0u) {
+        if (fresh) {
+            radiance.rgb += rho * carry_load(uvec3(entry.voxel));
+        } else {
+            radiance.rgb += max(imageLoad(shaded_radiance, entry.radiance_texel).rgb - direct_before.rgb, vec3(0.0));
+        }
     }
 #endif
     if (push.store_radiance != 0u) {

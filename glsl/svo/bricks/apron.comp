@@ -23,7 +23,7 @@ void main() {
     ivec3 origin = brick_origin(node_bricks[node], side, SVO_RADIANCE_BRICK) + 1;
     ivec3 coords = ivec3(unpack_coord(node_coords[node]));
     int last = (2 << push.level) - 1;
-    for (int i = 0; i < 64; i++) {
+    for (int i = first_item(); i < 64; i += item_step()) {
         ivec3 t = ivec3(i & 3, (i >> 2) & 3, i >> 4) - 1;
         if (all(greaterThanEqual(t, ivec3(0))) && all(lessThanEqual(t, ivec3(1)))) {
             continue;
@@ -44,5 +44,7 @@ void main() {
             }
         }
     }
-    brick_changes[change_slot(node_bricks[node], push.level)] = 0u;
+    if (first_item() == 0) {
+        brick_changes[change_slot(node_bricks[node], push.level)] = 0u;
+    }
 }

@@ -21,7 +21,7 @@ void main() {
     ivec3 out_origin = brick_origin(node_bricks[node], interior_side, SVO_RADIANCE_BRICK) + 1;
     uint tile = node_children[node] & SVO_CHILD_MASK;
     bool leaf_children = push.level + 2u == svo_depth();
-    for (int o = 0; o < 8; o++) {
+    for (int o = first_item(); o < 8; o += item_step()) {
         ivec3 voxel = ivec3(o & 1, (o >> 1) & 1, o >> 2);
         uint brick = node_bricks[tile + uint(o)];
         if (brick == SVO_NO_BRICK) {

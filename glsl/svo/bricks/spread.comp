@@ -11,7 +11,7 @@ void main() {
         return;
     }
     ivec3 coords = ivec3(unpack_coord(node_coords[node]));
-    for (int i = 0; i < 27; i++) {
+    for (int i = first_item(); i < 27; i += item_step()) {
         ivec3 step = ivec3(i % 3, (i / 3) % 3, i / 9) - 1;
         uint n = all(equal(step, ivec3(0))) ? node : offset_node(node, coords, step, push.level);
         uint brick = n == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[n];
@@ -19,7 +19,7 @@ void main() {
             mark_node(n, brick, push.level, SVO_BORDER, border_list(push.level));
         }
     }
-    if (push.level == 0u) {
+    if (push.level == 0u || first_item() != 0) {
         return;
     }
     uint parent_level = push.level - 1u;

@@ -26,4 +26,15 @@ bool level_node(out uint node) {
     node = level.appended_first + (i - statics);
     return i - statics < level.appended_count;
 }
+
+// This workgroup's share of each node's `items` items (texels, children, neighbours): over
+// an update list `SVO_LIST_SLICES` workgroups share a node's work, over a level one does
+// it all. Use as `for (int i = first_item(); i < items; i += item_step())`.
+int first_item() {
+    return int(gl_WorkGroupID.y);
+}
+
+int item_step() {
+    return int(gl_NumWorkGroups.y);
+}
 #endif
