@@ -146,6 +146,12 @@ gpu_layout! {
         BINDING_SVO_CHANGES = 31;
         /// SVO passes (set 2): the filter's update lists (Dřínovský 2013, 5.5): `SvoUpdateList[SVO_UPDATE_LISTS]`, `SvoBounceDispatch`, then each list's nodes (`SvoCounters.update_capacity` each), `uint[]` storage buffer.
         BINDING_SVO_UPDATES = 32;
+        /// SVO passes (set 2): the node grid, a dense index into the octree at level `depth - 1 - SVO_NODE_GRID_ABOVE_LEAVES` (`glsl/svo/octree/grid.comp`): per cell, its node there, or `SVO_GRID_GAP` plus the level of the childless node above where its cube is empty; cone samples start their descent from it, `uint[]` storage buffer.
+        BINDING_SVO_NODE_GRID = 36;
+        /// Levels between the node grid and the leaves: samples of the finest levels descend at most this far from the grid (from the root, 7 more at depth 10).
+        SVO_NODE_GRID_ABOVE_LEAVES = 3;
+        /// A node grid entry at or above this is no node: the cell is empty from level (entry - `SVO_GRID_GAP`) down.
+        SVO_GRID_GAP = 0xFFFFFF00;
         /// Update lists: nodes whose radiance changed, at levels of even and odd parity (0, 1), and nodes whose border must be copied again (2, 3).
         SVO_UPDATE_LISTS = 4;
         /// Bit of a brick's change word: its voxels' radiance changed (it is in a changed list).

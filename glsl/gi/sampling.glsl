@@ -56,7 +56,7 @@ bool locate(vec3 uvw, uint level, out BrickSample s) {
     vec3 q = clamp(uvw, 0.0, 1.0) * voxels;
     uvec3 node_coords = min(uvec3(q * 0.5), uvec3((1u << level) - 1u));
     uint empty;
-    uint node = find_node_or_gap(node_coords << (svo_depth() - level), level, empty);
+    uint node = find_node_or_gap_gridded(node_coords << (svo_depth() - level), level, empty);
     s.brick = node == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[node];
     s.local = q - vec3(node_coords * 2u);
     if (s.brick != SVO_NO_BRICK) {
@@ -79,7 +79,8 @@ bool locate(vec3 uvw, uint level, out BrickSample s) {
         if (any(greaterThan(step, span)) || all(equal(c, ivec3(node_coords)))) {
             continue;
         }
-        uint n = find_node(uvec3(c) << (svo_depth() - level), level);
+        uint gap;
+        uint n = find_node_or_gap_gridded(uvec3(c) << (svo_depth() - level), level, gap);
         uint brick = n == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[n];
         if (brick != SVO_NO_BRICK) {
             s.brick = brick;

@@ -42,6 +42,9 @@ layout(set = SET_PASS, binding = BINDING_SVO_STATIC_NODES, std430) readonly buff
 layout(set = SET_PASS, binding = BINDING_SVO_CHANGES, std430) buffer ChangesBlock {
     uint brick_changes[];
 };
+layout(set = SET_PASS, binding = BINDING_SVO_NODE_GRID, std430) buffer NodeGridBlock {
+    uint node_grid[];
+};
 layout(set = SET_PASS, binding = BINDING_SVO_UPDATES, std430) buffer UpdatesBlock {
     SvoUpdateList update_lists[SVO_UPDATE_LISTS];
     SvoBounceDispatch bounce_dispatch;
@@ -69,12 +72,12 @@ uint child_octant(uvec3 v, uint level) {
     return bit.x | (bit.y << 1) | (bit.z << 2);
 }
 
-// The node at `level` whose cube holds voxel `v` of the effective grid, or SVO_NO_NODE
-// where the octree has no node there; `empty` is then the level of the childless node
-// where the descent stopped, whose whole cube is empty.
-uint find_node_or_gap(uvec3 v, uint level, out uint empty) {
-    uint node = 0u;
-    for (uint l = 0u; l < level; l++) {
+// The node at `level` whose cube holds voxel `v` of the effective grid, descending from
+// `node` at level `from`, or SVO_NO_NODE where the octree has no node there; `empty` is
+// then the level of the childless node where the descent stopped, whose whole cube is
+// empty.
+uint find_node_below(uint node, uint from, uvec3 v, uint level, out uint empty) {
+    for (uint l = from; l < level; l++) {
         uint tile = node_children[node] & SVO_CHILD_MASK;
         if (tile == 0u) {
             empty = l;
@@ -86,9 +89,38 @@ uint find_node_or_gap(uvec3 v, uint level, out uint empty) {
     return node;
 }
 
+// The same from the root.
+uint find_node_or_gap(uvec3 v, uint level, out uint empty) {
+    return find_node_below(0u, 0u, v, level, empty);
+}
+
 uint find_node(uvec3 v, uint level) {
     uint empty;
     return find_node_or_gap(v, level, empty);
+}
+
+// The level of the node grid (`BINDING_SVO_NODE_GRID`).
+uint node_grid_level() {
+    return svo_depth() - 1u - SVO_NODE_GRID_ABOVE_LEAVES;
+}
+
+// As find_node_or_gap, from the node grid at and below its level: for the passes after
+// the octree's levels and the grid are built (cone tracing, bounces, debug views).
+uint find_node_or_gap_gridded(uvec3 v, uint level, out uint empty) {
+    uint g = node_grid_level();
+    uint node = 0u;
+    uint from = 0u;
+    if (level >= g) {
+        uvec3 cell = v >> (svo_depth() - g);
+        uint side = 1u << g;
+        node = node_grid[cell.x + side * (cell.y + side * cell.z)];
+        if (node >= SVO_GRID_GAP) {
+            empty = node - SVO_GRID_GAP;
+            return SVO_NO_NODE;
+        }
+        from = g;
+    }
+    return find_node_below(node, from, v, level, empty);
 }
 
 // Which of its leaf's 8 voxels voxel v is (x | y << 1 | z << 2).

@@ -144,6 +144,7 @@ pub fn bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_SVO_STATIC_NODES, storage, all),
         Binding::new(layout::BINDING_SVO_CHANGES, storage, all),
         Binding::new(layout::BINDING_SVO_UPDATES, storage, all),
+        Binding::new(layout::BINDING_SVO_NODE_GRID, storage, all),
         Binding::new(
             layout::BINDING_SVO_DIRECTIONAL_STORAGE,
             vk::DescriptorType::STORAGE_IMAGE,
@@ -159,6 +160,8 @@ pub struct SvoGi {
     pub depth: u32,
     /// `SvoCounters`, then `SvoLevel[SVO_MAX_LEVELS]`; also the indirect dispatches.
     counters: Buffer,
+    /// Where cone samples start their descent (`BINDING_SVO_NODE_GRID`).
+    node_grid: Buffer,
     fragments: Fragments,
     pools: Pools,
     voxelize: VoxelizePass,
@@ -226,11 +229,23 @@ impl SvoGi {
                 | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuOnly,
         )?;
+        let node_grid = Buffer::new(
+            ctx,
+            "svo node grid",
+            4 * u64::from(octree::node_grid_cells(depth)),
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::GpuOnly,
+        )?;
         SetWriter::new(ctx, set)
             .buffer(
                 layout::BINDING_SVO_COUNTERS,
                 vk::DescriptorType::STORAGE_BUFFER,
                 counters.raw,
+            )
+            .buffer(
+                layout::BINDING_SVO_NODE_GRID,
+                vk::DescriptorType::STORAGE_BUFFER,
+                node_grid.raw,
             )
             .apply();
         let fragments = Fragments::new(ctx, capacities.fragments)?;
@@ -241,6 +256,7 @@ impl SvoGi {
             grid,
             depth,
             counters,
+            node_grid,
             fragments,
             pools,
             voxelize: VoxelizePass::new(
@@ -413,6 +429,7 @@ impl SvoGi {
                 self.fragments.voxels.size + self.fragments.shading.size,
             ),
             ("svo_counters", self.counters.size),
+            ("svo_node_grid", self.node_grid.size),
         ];
         bytes.extend(self.pools.bytes());
         bytes
@@ -841,6 +858,10 @@ impl SvoGi {
             vk::PipelineStageFlags2::COMPUTE_SHADER,
             vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
         );
+        timer.end(cmd);
+        timer.begin(cmd, "node grid");
+        self.octree.record_grid(cmd, &sets, self.depth);
+        compute_to_compute(ctx, cmd);
         timer.end(cmd);
         if build && self.moving && !self.full_update {
             stage_barrier(

@@ -21,6 +21,11 @@ pub fn level_offset(level: u32) -> vk::DeviceSize {
         as vk::DeviceSize
 }
 
+/// Cells of the node grid of an octree of `depth` levels (`BINDING_SVO_NODE_GRID`).
+pub fn node_grid_cells(depth: u32) -> u32 {
+    1 << (3 * (depth - 1 - layout::SVO_NODE_GRID_ABOVE_LEAVES))
+}
+
 /// What a pass over the octree runs over: one invocation per item.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Over {
@@ -96,6 +101,7 @@ pub struct OctreePasses {
     level: Pipeline,
     init: Pipeline,
     neighbours: Pipeline,
+    grid: Pipeline,
 }
 
 /// Makes the level table written by a compute pass readable as indirect dispatches and by
@@ -129,7 +135,21 @@ impl OctreePasses {
             level: pipeline("svo level", s::SVO_OCTREE_LEVEL_COMP)?,
             init: pipeline("svo init", s::SVO_OCTREE_INIT_COMP)?,
             neighbours: pipeline("svo neighbours", s::SVO_OCTREE_NEIGHBOURS_COMP)?,
+            grid: pipeline("svo node grid", s::SVO_OCTREE_GRID_COMP)?,
         })
+    }
+
+    /// Enters the nodes (or gaps) of level `node_grid_level(depth)` into the node grid,
+    /// once the octree's levels are built.
+    pub fn record_grid(
+        &self,
+        cmd: vk::CommandBuffer,
+        sets: &[(u32, vk::DescriptorSet)],
+        depth: u32,
+    ) {
+        let cells = node_grid_cells(depth);
+        self.grid
+            .dispatch(cmd, sets, [cells.div_ceil(layout::SVO_GROUP_SIZE), 1, 1]);
     }
 
     /// Builds levels 1 to `depth - 1` under the root (whose entries and level-table rows

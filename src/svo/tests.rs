@@ -235,6 +235,30 @@ fn check_structure(svo: &SvoGi, d: &Downloaded) -> HashSet<[u32; 3]> {
         assert_eq!(interior_bricks.len() as u32, counters.interior_bricks);
     }
 
+    // The node grid: per cell, its node, or where the descent to it stops (the deepest
+    // node above it, which has no children).
+    let grid = svo.download_words(&svo.node_grid).unwrap();
+    let g = depth - 1 - layout::SVO_NODE_GRID_ABOVE_LEAVES;
+    let side = 1u32 << g;
+    let mut gaps = 0;
+    for (i, &entry) in grid.iter().enumerate() {
+        let i = i as u32;
+        let c = [i % side, (i / side) % side, i / (side * side)];
+        let expected = match by_coords[g as usize].get(&c) {
+            Some(&node) => node,
+            None => {
+                gaps += 1;
+                let above = (0..g)
+                    .rev()
+                    .find(|&l| by_coords[l as usize].contains_key(&c.map(|x| x >> (g - l))))
+                    .expect("the root holds every cell");
+                layout::SVO_GRID_GAP + above
+            }
+        };
+        assert_eq!(entry, expected, "node grid cell {c:?}");
+    }
+    eprintln!("node grid at level {g}: {} cells, {gaps} empty", grid.len());
+
     // Neighbours: the node at the next coordinates of the same level, and symmetric.
     let mut links = 0;
     for (l, map) in by_coords.iter().enumerate() {
