@@ -831,7 +831,6 @@ impl VoxelGi {
         self.set
     }
 
-    /// The octree, with `--gi svo`.
     #[cfg(test)]
     pub fn octree_mut(&mut self) -> Option<&mut SvoGi> {
         match &mut self.voxels {
@@ -840,6 +839,7 @@ impl VoxelGi {
         }
     }
 
+    /// The octree, with `--gi svo`.
     pub fn octree(&self) -> Option<&SvoGi> {
         match &self.voxels {
             Voxels::Octree(svo) => Some(svo),
@@ -952,8 +952,9 @@ impl VoxelGi {
     /// of one (moving light takes a few frames to settle in the indirect light).
     ///
     /// With moving meshes every frame inserts them into the octree's static part, and
-    /// their bricks are assigned anew; the light its voxels gathered is carried over by voxel (`crate::svo`), so
-    /// bounces still accumulate one per frame. `slot` is the frame's slot in flight.
+    /// their bricks are assigned anew; the light the voxels of new bricks gathered is
+    /// carried over by voxel (`crate::svo`), the others keep theirs, so bounces still
+    /// accumulate one per frame. `slot` is the frame's slot in flight.
     ///
     /// `lighting` holds everything voxel shading reads besides the voxels (the lights,
     /// their shadow views, the shadow mode): while it stays the same, the octree shades
