@@ -119,7 +119,7 @@ gpu_layout! {
         /// the dense grid holds volumes): `SvoCounters` then `SvoLevel[SVO_MAX_LEVELS]`,
         /// storage buffer.
         BINDING_SVO_COUNTERS = 20;
-        /// SVO passes (set 2): the voxel-fragment list, first half: per fragment its voxel (x | y << 10 | z << 20) and RGBA8 albedo, `uvec2[]` storage buffer. (Two halves of 8 bytes, so that each fits the 128 MiB that lavapipe binds at depth 9.)
+        /// SVO passes (set 2): the voxel-fragment list, first half: the fragments' voxels (x | y << 10 | z << 20), then their RGBA8 albedos (from `SvoCounters.fragment_capacity` on; the octree's passes read only the voxels), `uint[]` storage buffer. (Two halves of 8 bytes, so that each fits the 128 MiB that lavapipe binds at depth 9.)
         BINDING_SVO_FRAGMENTS = 21;
         /// SVO passes (set 2): the voxel-fragment list, second half: per fragment its RGBA8 normal (xyz * 0.5 + 0.5) and emission / `GiUniforms.emission_range`, `uvec2[]` storage buffer.
         BINDING_SVO_FRAGMENT_SHADING = 28;

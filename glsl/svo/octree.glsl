@@ -10,10 +10,11 @@ layout(set = SET_PASS, binding = BINDING_SVO_COUNTERS, std430) buffer CountersBl
     SvoCounters counters;
     SvoLevel levels[SVO_MAX_LEVELS];
 };
-// Fragment i: its voxel and albedo in fragment_voxels[i], normal and emission in
-// fragment_shading[i].
+// Fragment i: its voxel in fragment_voxels[i] and its albedo in
+// fragment_voxels[counters.fragment_capacity + i] (the octree's passes read only the
+// voxels, contiguous), normal and emission in fragment_shading[i].
 layout(set = SET_PASS, binding = BINDING_SVO_FRAGMENTS, std430) buffer FragmentsBlock {
-    uvec2 fragment_voxels[];
+    uint fragment_voxels[];
 };
 layout(set = SET_PASS, binding = BINDING_SVO_FRAGMENT_SHADING, std430) buffer ShadingBlock {
     uvec2 fragment_shading[];
@@ -105,7 +106,7 @@ uint node_grid_level() {
 }
 
 // As find_node_or_gap, from the node grid at and below its level: for the passes after
-// the octree's levels and the grid are built (cone tracing, bounces, debug views).
+// the octree's levels and the grid are built (brick fill, cone tracing, bounces).
 uint find_node_or_gap_gridded(uvec3 v, uint level, out uint empty) {
     uint g = node_grid_level();
     uint node = 0u;

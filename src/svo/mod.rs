@@ -827,6 +827,11 @@ impl SvoGi {
         let counters = self.counters.raw;
         self.octree
             .record(ctx, cmd, timer, &sets, counters, self.depth, neighbours);
+        // The brick fill and every pass after it find nodes from the node grid.
+        timer.begin(cmd, "node grid");
+        self.octree.record_grid(cmd, &sets, self.depth);
+        compute_to_compute(ctx, cmd);
+        timer.end(cmd);
 
         timer.begin(cmd, "brick fill");
         if build {
@@ -858,10 +863,6 @@ impl SvoGi {
             vk::PipelineStageFlags2::COMPUTE_SHADER,
             vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
         );
-        timer.end(cmd);
-        timer.begin(cmd, "node grid");
-        self.octree.record_grid(cmd, &sets, self.depth);
-        compute_to_compute(ctx, cmd);
         timer.end(cmd);
         if build && self.moving && !self.full_update {
             stage_barrier(

@@ -465,7 +465,8 @@ impl Pools {
     }
 }
 
-/// The voxel-fragment list, in two halves of 8 bytes per fragment.
+/// The voxel-fragment list, in two halves of 8 bytes per fragment: the voxels then the
+/// albedos (`voxels`), the normals and emissions (`shading`).
 pub(super) struct Fragments {
     pub(super) capacity: u32,
     pub(super) voxels: Buffer,

@@ -80,8 +80,8 @@ fn download(svo: &SvoGi) -> Downloaded {
     Downloaded {
         fragments: (0..stored)
             .map(|i| Fragment {
-                position: voxels[2 * i],
-                albedo: voxels[2 * i + 1],
+                position: voxels[i],
+                albedo: voxels[svo.fragments.capacity as usize + i],
                 normal: shading[2 * i],
                 emission: shading[2 * i + 1],
             })

@@ -17,10 +17,10 @@ void main() {
     if (index >= min(counters.fragment_count, counters.fragment_capacity)) {
         return;
     }
-    uvec2 at = fragment_voxels[index];
     uvec2 shading = fragment_shading[index];
-    uvec3 v = unpack_coord(at.x);
-    uint leaf = find_node(v, svo_depth() - 1u);
+    uvec3 v = unpack_coord(fragment_voxels[index]);
+    uint empty;
+    uint leaf = find_node_or_gap_gridded(v, svo_depth() - 1u, empty);
     if (leaf == SVO_NO_NODE || node_bricks[leaf] == SVO_NO_BRICK) {
         return;
     }
@@ -30,7 +30,7 @@ void main() {
         return;
     }
     uint base = leaf_sum_base(entry, octant);
-    uint words[3] = uint[3](at.y, shading.x, shading.y);
+    uint words[3] = uint[3](fragment_voxels[counters.fragment_capacity + index], shading.x, shading.y);
     for (uint a = 0u; a < 3u; a++) {
         for (uint c = 0u; c < 3u; c++) {
             atomicAdd(leaf_sums[base + 3u * a + c], (words[a] >> (8u * c)) & 0xffu);

@@ -28,7 +28,8 @@ void store_voxel(ivec3 voxel, vec3 albedo, vec3 normal, vec3 emission) {
         atomicOr(counters.overflow, SVO_OVERFLOW_FRAGMENTS);
         return;
     }
-    fragment_voxels[index] = uvec2(pack_coord(uvec3(voxel)), pack_rgba8(vec4(albedo * 255.0, 255.0)));
+    fragment_voxels[index] = pack_coord(uvec3(voxel));
+    fragment_voxels[counters.fragment_capacity + index] = pack_rgba8(vec4(albedo * 255.0, 255.0));
     fragment_shading[index] = uvec2(pack_rgba8(vec4(normal * 255.0, 255.0)), pack_rgba8(vec4(emission * 255.0, 255.0)));
     uint read = index - counters.fragment_base;
     if (read % SVO_GROUP_SIZE == 0u) {

@@ -16,7 +16,7 @@ void main() {
     if (index >= min(counters.fragment_count, counters.fragment_capacity)) {
         return;
     }
-    uvec3 v = unpack_coord(fragment_voxels[index].x);
+    uvec3 v = unpack_coord(fragment_voxels[index]);
     uint node = find_node(v, push.level);
     // Every ancestor holds this fragment, so it was subdivided, unless the node pool
     // overflowed (reported; the host builds again with a larger pool).
