@@ -115,9 +115,11 @@ pub fn light_views(
     }
 }
 
-/// All shadow views of the scene at time t, in light order.
+/// All shadow views of the scene at time t, in light order. They cover the scene's
+/// bounds over all times, so that only moving lights move them: a moving mesh changes
+/// only the texels it covers or covered.
 pub fn scene_views(scene: &Scene, time_s: f32, resolution: u32) -> Vec<ShadowView> {
-    let bounds = scene.bounds(time_s);
+    let bounds = scene.swept_bounds();
     let mut views = Vec::new();
     for i in 0..scene.lights.len() {
         let light = scene.light_at(i, time_s);

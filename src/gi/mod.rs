@@ -52,10 +52,10 @@ impl Grid {
         i as usize + n * (j as usize + n * k as usize)
     }
 
-    /// A cube around the scene's bounds at time 0, with a little room so that surfaces
-    /// on the bounds are not cut by the grid's edge.
+    /// A cube around the scene's bounds over all times (moving meshes never leave it),
+    /// with a little room so that surfaces on the bounds are not cut by the grid's edge.
     pub fn around(scene: &Scene, resolution: u32) -> Self {
-        let bounds = scene.bounds(0.0);
+        let bounds = scene.swept_bounds();
         let size = (bounds.max - bounds.min).max_element().max(1e-3) * 1.04;
         Self {
             origin: bounds.center() - Vec3::splat(size * 0.5),

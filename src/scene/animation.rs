@@ -36,6 +36,33 @@ impl Animation {
             } => Mat4::from_translation(axis.normalize() * amplitude * (TAU * t / period_s).sin()),
         }
     }
+
+    /// Object-space bounds that hold `part` (bounds of a part of an object whose bounds
+    /// are `object_bounds`) at every time of the motion: a spin sweeps the sphere about
+    /// the object's centre through the part's farthest corner, an oscillation the part at
+    /// both ends of its stroke.
+    pub fn swept(&self, part: &Aabb, object_bounds: &Aabb) -> Aabb {
+        if part.is_empty() {
+            return *part;
+        }
+        match *self {
+            Animation::Spin { .. } => {
+                let c = object_bounds.center();
+                let r = (part.min - c).abs().max((part.max - c).abs()).length();
+                Aabb {
+                    min: c - Vec3::splat(r),
+                    max: c + Vec3::splat(r),
+                }
+            }
+            Animation::Oscillate {
+                axis, amplitude, ..
+            } => {
+                let stroke = axis.normalize() * amplitude;
+                part.transformed(Mat4::from_translation(stroke))
+                    .union(&part.transformed(Mat4::from_translation(-stroke)))
+            }
+        }
+    }
 }
 
 /// A light position rotating about `center` around `axis` (right-handed), once per
@@ -93,6 +120,35 @@ mod tests {
             .abs_diff_eq(Mat4::IDENTITY, 1e-6));
         let peak = wobble.matrix(&BOUNDS, 0.5).transform_point3(Vec3::ZERO);
         assert!(peak.abs_diff_eq(Vec3::new(0.5, 0.0, 0.0), 1e-6), "{peak}");
+    }
+
+    #[test]
+    fn swept_bounds_hold_the_part_at_all_times() {
+        let part = Aabb {
+            min: Vec3::new(1.5, 2.0, 3.0),
+            max: Vec3::new(2.0, 3.0, 4.0),
+        };
+        let motions = [
+            Animation::Spin {
+                axis: Vec3::new(1.0, 1.0, 0.0),
+                deg_per_s: 37.0,
+            },
+            Animation::Oscillate {
+                axis: Vec3::new(0.0, 1.0, 1.0),
+                amplitude: 0.7,
+                period_s: 3.0,
+            },
+        ];
+        for motion in motions {
+            let swept = motion.swept(&part, &BOUNDS);
+            for i in 0..200 {
+                let now = part.transformed(motion.matrix(&BOUNDS, i as f32 * 0.05));
+                assert!(
+                    now.min.cmpge(swept.min - 1e-5).all() && now.max.cmple(swept.max + 1e-5).all(),
+                    "{motion:?} at step {i}: {now:?} outside {swept:?}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -697,6 +697,22 @@ radiance = [0.3, 0.35, 0.45]
         let moved = scene.mesh_transform(1, 1.0).transform_point3(Vec3::ZERO);
         assert!(moved.abs_diff_eq(Vec3::new(0.5, 0.0, 0.0), 1e-5), "{moved}");
         assert!(scene.bounds(1.0).max.x > scene.bounds(0.0).max.x);
+        // The swept bounds hold the scene at every time, and the shadow views built from
+        // them stay put while the meshes move (the lights held still).
+        let swept = scene.swept_bounds();
+        for i in 0..40 {
+            let now = scene.bounds(i as f32 * 0.1);
+            assert!(now.min.cmpge(swept.min - 1e-5).all() && now.max.cmple(swept.max + 1e-5).all());
+        }
+        let mut still = scene.clone();
+        for light in &mut still.lights {
+            light.orbit = None;
+        }
+        let views = |t| crate::shadow::scene_views(&still, t, 512);
+        assert_eq!(
+            bytemuck::cast_slice::<_, u8>(&views(0.0)),
+            bytemuck::cast_slice::<_, u8>(&views(1.0))
+        );
 
         assert_eq!(scene.lights.len(), 3);
         assert_eq!(scene.lights[0].intensity, Vec3::splat(3.0));

@@ -251,6 +251,19 @@ impl Scene {
         })
     }
 
+    /// World bounds that hold the scene at every time (moving meshes over their whole
+    /// motion): what the shadow maps and the voxel grid cover, so that they stay put as
+    /// meshes move.
+    pub fn swept_bounds(&self) -> Aabb {
+        self.meshes.iter().fold(Aabb::EMPTY, |b, m| {
+            let object = match &m.animation {
+                Some(a) => a.swept(&m.local_bounds, &m.object_bounds),
+                None => m.local_bounds,
+            };
+            b.union(&object.transformed(m.transform))
+        })
+    }
+
     /// Object to world of mesh `mesh` at time `time_s`: the animation acts in object space.
     pub fn mesh_transform(&self, mesh: usize, time_s: f32) -> Mat4 {
         let m = &self.meshes[mesh];
