@@ -8,6 +8,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use crate::gi::{check_voxels, ConeSettings, VoxelStructure, DEFAULT_VOXELS};
 use crate::renderer::{DebugView, GiSettings, RenderSettings, Terms, Tonemap};
 use crate::scene::{GiOverrides, LoadOptions};
+use crate::shadow::ShadowResolution;
 use crate::svo::check_depth;
 
 #[derive(Parser, Debug)]
@@ -77,9 +78,13 @@ pub struct CommonArgs {
     /// Tonemap for PNG and window output.
     #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
     pub tonemap: Tonemap,
-    /// Shadow map resolution per light view.
+    /// Shadow map resolution of each view of a point or spot light.
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub shadow_res: u32,
+    /// Shadow map resolution of a directional light, whose one view covers the whole
+    /// scene.
+    #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    pub sun_shadow_res: u32,
     /// Voxels per axis of the dense grid, a power of two from 4 to 1024 [default: 64,
     /// or the scene file's [gi] voxels].
     #[arg(long)]
@@ -358,7 +363,10 @@ impl CommonArgs {
             normal_maps: !options.no_normal_maps,
             exposure_ev: self.exposure,
             tonemap: self.tonemap,
-            shadow_resolution: self.shadow_res,
+            shadow_resolution: ShadowResolution {
+                local: self.shadow_res,
+                directional: self.sun_shadow_res,
+            },
             cache_shadows: true,
             terms: Terms {
                 direct: !self.no_direct,

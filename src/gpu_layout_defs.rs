@@ -300,6 +300,14 @@ gpu_layout! {
         float near,
         /// Far plane distance (perspective).
         float far,
+        /// Texels of the view along each side; it fills that corner of its layer (views of different lights may have different resolutions; the layers fit the largest).
+        uint resolution,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+        /// Unused.
+        uint pad2,
     }
 
     /// One material.

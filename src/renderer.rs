@@ -16,7 +16,7 @@ use crate::gpu_layout::{self as layout, FrameUniforms, GpuLight, ShadowView};
 use crate::lighting::LightingPass;
 use crate::scene::{Camera, LightKind, Scene};
 use crate::scene_gpu::{GpuScene, SceneDraw};
-use crate::shadow::{self, ShadowPass};
+use crate::shadow::{self, ShadowPass, ShadowResolution};
 use crate::vk::{
     copies_to_host_barrier, image_barrier, sampler_info, Binding, Buffer, Context, DescriptorSets,
     Frame, FrameRing, GpuTimer, Image, ImageUse, Sampler, SetWriter,
@@ -142,8 +142,8 @@ pub struct RenderSettings {
     /// Exposure in stops applied before the tonemap (not to EXR output).
     pub exposure_ev: f32,
     pub tonemap: Tonemap,
-    /// Edge of each shadow map layer in texels.
-    pub shadow_resolution: u32,
+    /// Texels per side of each light view's shadow map.
+    pub shadow_resolution: ShadowResolution,
     /// Keep the shadow maps while no light and no mesh moves.
     pub cache_shadows: bool,
     /// Indirect light; `None` for direct light only.
@@ -162,7 +162,7 @@ impl Default for RenderSettings {
             normal_maps: true,
             exposure_ev: 0.0,
             tonemap: Tonemap::Clamp,
-            shadow_resolution: 1024,
+            shadow_resolution: ShadowResolution::default(),
             cache_shadows: true,
             gi: None,
             terms: Terms::default(),

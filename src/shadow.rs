@@ -21,11 +21,43 @@ pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// edge still land inside the face.
 const CUBE_FACE_FOV_DEG: f32 = 95.0;
 
+/// Shadow map resolution (texels per side) of each light view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowResolution {
+    /// Each view of a point or spot light.
+    pub local: u32,
+    /// A directional light's one view, which covers the whole scene.
+    pub directional: u32,
+}
+
+impl Default for ShadowResolution {
+    fn default() -> Self {
+        Self {
+            local: 1024,
+            directional: 4096,
+        }
+    }
+}
+
+impl ShadowResolution {
+    /// Of each view of `light`.
+    pub fn of(&self, light: &Light) -> u32 {
+        match light.kind {
+            LightKind::Directional { .. } => self.directional,
+            LightKind::Point | LightKind::Spot { .. } => self.local,
+        }
+    }
+
+    /// Of the shadow map's layers: the largest of `scene`'s views.
+    fn layers(&self, scene: &Scene) -> u32 {
+        scene.lights.iter().map(|l| self.of(l)).max().unwrap_or(16)
+    }
+}
+
 pub struct ShadowPass {
     pub map: Image,
     layer_views: Vec<OwnedView>,
     pipeline: Pipeline,
-    pub resolution: u32,
 }
 
 /// Number of shadow views a light needs.
@@ -68,6 +100,8 @@ pub fn light_views(
             layer,
             near,
             far,
+            resolution,
+            ..Default::default()
         }
     };
     match light.kind {
@@ -110,6 +144,8 @@ pub fn light_views(
                 layer: first_layer,
                 near: radius,
                 far: radius * 3.0,
+                resolution,
+                ..Default::default()
             }]
         }
     }
@@ -118,13 +154,13 @@ pub fn light_views(
 /// All shadow views of the scene at time t, in light order. They cover the scene's
 /// bounds over all times, so that only moving lights move them: a moving mesh changes
 /// only the texels it covers or covered.
-pub fn scene_views(scene: &Scene, time_s: f32, resolution: u32) -> Vec<ShadowView> {
+pub fn scene_views(scene: &Scene, time_s: f32, resolution: ShadowResolution) -> Vec<ShadowView> {
     let bounds = scene.swept_bounds();
     let mut views = Vec::new();
     for i in 0..scene.lights.len() {
         let light = scene.light_at(i, time_s);
         let first = views.len() as u32;
-        views.extend(light_views(&light, &bounds, resolution, first));
+        views.extend(light_views(&light, &bounds, resolution.of(&light), first));
     }
     views
 }
@@ -133,14 +169,15 @@ impl ShadowPass {
     pub fn new(
         ctx: &Arc<Context>,
         scene: &Scene,
-        resolution: u32,
+        resolution: ShadowResolution,
         set_layouts: &[vk::DescriptorSetLayout],
     ) -> Result<Self> {
         let layers: u32 = scene.lights.iter().map(view_count).sum::<u32>().max(1);
+        let edge = resolution.layers(scene);
         let mut desc = ImageDesc::d2(
             DEPTH_FORMAT,
-            resolution,
-            resolution,
+            edge,
+            edge,
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
         );
         // At least two layers, so that the image's view is a 2D array (the shaders sample a
@@ -173,7 +210,6 @@ impl ShadowPass {
             map,
             layer_views,
             pipeline,
-            resolution,
         })
     }
 
@@ -196,11 +232,12 @@ impl ShadowPass {
             ImageUse::discard_after(Self::FINAL_USE),
             ImageUse::DEPTH_ATTACHMENT,
         );
-        let extent = vk::Extent2D {
-            width: self.resolution,
-            height: self.resolution,
-        };
         for (index, view) in views.iter().enumerate() {
+            // The view fills the corner of its layer that its resolution asks for.
+            let extent = vk::Extent2D {
+                width: view.resolution,
+                height: view.resolution,
+            };
             let depth = vk::RenderingAttachmentInfo::default()
                 .image_view(self.layer_views[view.layer as usize].raw)
                 .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)

@@ -74,6 +74,41 @@ fn cornell_point_direct_matches_reference() {
     );
 }
 
+/// Shadow maps of different resolutions share the map's layers: a point light's six views
+/// (1024 texels) keep their shadows when a directional light's view (4096) makes the
+/// layers larger, bit for bit (the Cornell box with its point light, then with a
+/// directional light of zero irradiance beside it, which adds no light).
+#[test]
+fn point_light_shadows_are_the_same_beside_a_larger_sun_map() {
+    let Some(shared) = shared() else { return };
+    let dir = temp_dir("shadow_layers");
+    let obj = shared.join("scenes/cornell_box/CornellBox-Original.obj");
+    let point = format!(
+        "[[mesh]]\npath = {:?}\nemission_scale = 0.0\n[[light]]\nkind = \"point\"\n\
+         position = [0.0, 1.5, 0.0]\nintensity = [3.0, 3.0, 3.0]\n",
+        obj.to_string_lossy()
+    );
+    let sun = "[[light]]\nkind = \"directional\"\ndirection = [0.3, -1.0, -0.4]\n\
+               irradiance = [0.0, 0.0, 0.0]\n";
+    let mut images = Vec::new();
+    for (name, text) in [("point", point.clone()), ("beside_sun", point + sun)] {
+        let scene = dir.join(format!("{name}.toml"));
+        std::fs::write(&scene, text).unwrap();
+        let out = dir.join(format!("{name}.exr"));
+        common::render_256(&scene, &["--gi", "off"], &out);
+        images.push(load_rgb(&out).unwrap().0.data);
+    }
+    let differing = images[0]
+        .iter()
+        .zip(&images[1])
+        .filter(|(a, b)| a != b)
+        .count();
+    let shadowed = images[0].chunks_exact(3).filter(|p| p == &[0.0; 3]).count();
+    eprintln!("{differing} values differ; {shadowed} pixels unlit");
+    assert!(shadowed > 1000, "nothing unlit to compare");
+    assert_eq!(differing, 0);
+}
+
 /// Crytek Sponza at 512x512: textures (with mips), cut-outs and normal maps render with
 /// validation clean, and the sunlit floor shows texture detail.
 #[test]

@@ -43,8 +43,10 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset, int 
     float texel_world = shadow_texel_world(view, p);
     vec4 clip = view.view_proj * vec4(p + n * (2.0 * texel_world + extra_offset), 1.0);
     vec3 ndc = clip.xyz / clip.w;
-    vec2 uv = ndc.xy * 0.5 + 0.5;
-    vec2 texel_uv = 1.0 / vec2(textureSize(shadow_map, 0).xy);
+    // The view fills the corner of its layer that its resolution asks for.
+    vec2 layer_texels = vec2(textureSize(shadow_map, 0).xy);
+    vec2 uv = (ndc.xy * 0.5 + 0.5) * float(view.resolution) / layer_texels;
+    vec2 texel_uv = 1.0 / layer_texels;
     float sum = 0.0;
     for (int y = -pcf_radius; y <= pcf_radius; y++) {
         for (int x = -pcf_radius; x <= pcf_radius; x++) {

@@ -708,7 +708,7 @@ radiance = [0.3, 0.35, 0.45]
         for light in &mut still.lights {
             light.orbit = None;
         }
-        let views = |t| crate::shadow::scene_views(&still, t, 512);
+        let views = |t| crate::shadow::scene_views(&still, t, Default::default());
         assert_eq!(
             bytemuck::cast_slice::<_, u8>(&views(0.0)),
             bytemuck::cast_slice::<_, u8>(&views(1.0))
