@@ -79,8 +79,7 @@ bool locate(vec3 uvw, uint level, out BrickSample s) {
         if (any(greaterThan(step, span)) || all(equal(c, ivec3(node_coords)))) {
             continue;
         }
-        uint gap;
-        uint n = find_node_or_gap_gridded(uvec3(c) << (svo_depth() - level), level, gap);
+        uint n = find_node_gridded(uvec3(c) << (svo_depth() - level), level);
         uint brick = n == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[n];
         if (brick != SVO_NO_BRICK) {
             s.brick = brick;

@@ -106,7 +106,8 @@ uint node_grid_level() {
 }
 
 // As find_node_or_gap, from the node grid at and below its level: for the passes after
-// the octree's levels and the grid are built (brick fill, cone tracing, bounces).
+// the octree's levels and the grid are built (brick fill, voxel list on, every pass of a
+// frame's shading, filtering and tracing); the build's own passes descend from the root.
 uint find_node_or_gap_gridded(uvec3 v, uint level, out uint empty) {
     uint g = node_grid_level();
     uint node = 0u;
@@ -124,6 +125,11 @@ uint find_node_or_gap_gridded(uvec3 v, uint level, out uint empty) {
     return find_node_below(node, from, v, level, empty);
 }
 
+uint find_node_gridded(uvec3 v, uint level) {
+    uint empty;
+    return find_node_or_gap_gridded(v, level, empty);
+}
+
 // Which of its leaf's 8 voxels voxel v is (x | y << 1 | z << 2).
 uint leaf_octant(uvec3 v) {
     uvec3 k = v & 1u;
@@ -139,7 +145,7 @@ uint leaf_sum_base(uint entry, uint octant) {
 
 // The texel of voxel v in its leaf's attribute bricks; false where no leaf holds it.
 bool leaf_texel(uvec3 v, out ivec3 texel) {
-    uint leaf = find_node(v, svo_depth() - 1u);
+    uint leaf = find_node_gridded(v, svo_depth() - 1u);
     uint brick = leaf == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[leaf];
     texel = ivec3(0);
     if (brick == SVO_NO_BRICK) {
@@ -151,8 +157,8 @@ bool leaf_texel(uvec3 v, out ivec3 texel) {
 }
 
 // The node at `level` at offset `step` (each -1, 0 or 1) from `node` at `coords`: through
-// the neighbour pointers (one to three hops), or searched from the root where a hop meets
-// no link (a diagonal neighbour can exist beside missing face neighbours; a static node
+// the neighbour pointers (one to three hops), or searched from the node grid where a hop
+// meets no link (a diagonal neighbour can exist beside missing face neighbours; a static node
 // has no links to the nodes a frame appends).
 uint offset_node(uint node, ivec3 coords, ivec3 step, uint level) {
     uint n = node;
@@ -167,7 +173,7 @@ uint offset_node(uint node, ivec3 coords, ivec3 step, uint level) {
         if (any(lessThan(at, ivec3(0))) || any(greaterThanEqual(at, ivec3(side)))) {
             return SVO_NO_NODE;
         }
-        n = find_node(uvec3(at) << (svo_depth() - level), level);
+        n = find_node_gridded(uvec3(at) << (svo_depth() - level), level);
     }
     return n;
 }

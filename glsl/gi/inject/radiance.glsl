@@ -33,7 +33,7 @@ void store_radiance(ListedVoxel entry, vec4 radiance) {
     }
     imageStore(shaded_radiance, entry.radiance_texel, radiance);
     uint level = svo_depth() - 1u;
-    uint node = find_node(uvec3(entry.voxel), level);
+    uint node = find_node_gridded(uvec3(entry.voxel), level);
     if (node != SVO_NO_NODE) {
         mark_node(node, entry.brick, level, SVO_CHANGED, changed_list(level));
     }

@@ -23,7 +23,7 @@ void main() {
         return;
     }
     uint parent_level = push.level - 1u;
-    uint parent = find_node(uvec3(coords) << (svo_depth() - push.level), parent_level);
+    uint parent = find_node_gridded(uvec3(coords) << (svo_depth() - push.level), parent_level);
     uint brick = parent == SVO_NO_NODE ? SVO_NO_BRICK : node_bricks[parent];
     if (brick != SVO_NO_BRICK) {
         mark_node(parent, brick, parent_level, SVO_CHANGED, changed_list(parent_level));
