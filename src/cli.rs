@@ -96,9 +96,18 @@ pub struct CommonArgs {
     /// Full aperture of each diffuse cone, degrees, 1 to 179 [default: 60].
     #[arg(long)]
     pub diffuse_aperture: Option<f32>,
-    /// Cone step as a fraction of the cone's diameter (beta), 0.05 to 2 [default: 0.5].
+    /// Step of the cones gathering light for the pixels (diffuse, specular, refraction)
+    /// as a fraction of the cone's diameter (beta), 0.05 to 2 [default: 0.25].
     #[arg(long)]
     pub step_factor: Option<f32>,
+    /// Step of the voxel bounce's diffuse cones as a fraction of the cone's diameter,
+    /// 0.05 to 2 [default: 0.5].
+    #[arg(long)]
+    pub bounce_step_factor: Option<f32>,
+    /// Step of the soft-shadow cones as a fraction of the cone's diameter, 0.05 to 2
+    /// [default: 0.5].
+    #[arg(long)]
+    pub shadow_step_factor: Option<f32>,
     /// Step the diffuse cones level by level, each sample twice as far and wide as the
     /// last (Dřínovský's sampling of wide cones), instead of by the step factor.
     #[arg(long)]
@@ -306,6 +315,14 @@ impl CommonArgs {
                 .step_factor
                 .or(scene.step_factor)
                 .unwrap_or(d.step_factor),
+            bounce_step_factor: self
+                .bounce_step_factor
+                .or(scene.bounce_step_factor)
+                .unwrap_or(d.bounce_step_factor),
+            shadow_step_factor: self
+                .shadow_step_factor
+                .or(scene.shadow_step_factor)
+                .unwrap_or(d.shadow_step_factor),
             wide_steps_by_level: self.wide_steps_by_level
                 || scene.wide_steps_by_level.unwrap_or(d.wide_steps_by_level),
             accumulate_bounces: !self.no_accumulate,
@@ -493,5 +510,35 @@ mod tests {
         .gi
         .unwrap();
         assert_eq!((gi.voxels, gi.cones.diffuse_cones), (16, 4));
+    }
+
+    #[test]
+    fn each_kind_of_cone_takes_its_own_step() {
+        let scene = GiOverrides {
+            bounce_step_factor: Some(0.4),
+            ..Default::default()
+        };
+        let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
+            Some(Command::Render(r)) => r.common.render_settings(&scene),
+            _ => unreachable!(),
+        };
+        let gi = parse(&["voxcone", "render", "--shadow-step-factor", "0.3"])
+            .unwrap()
+            .gi
+            .unwrap();
+        let d = ConeSettings::default();
+        assert_eq!(
+            (
+                gi.cones.step_factor,
+                gi.cones.bounce_step_factor,
+                gi.cones.shadow_step_factor
+            ),
+            (d.step_factor, 0.4, 0.3)
+        );
+        let err = parse(&["voxcone", "render", "--bounce-step-factor", "3"]).unwrap_err();
+        assert!(
+            format!("{err:#}").contains("--bounce-step-factor"),
+            "{err:#}"
+        );
     }
 }

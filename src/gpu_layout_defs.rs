@@ -338,8 +338,12 @@ gpu_layout! {
         uint directional_levels,
         /// Emission is stored divided by this (the scene's largest emitted radiance).
         float emission_range,
-        /// Cone step as a fraction of the cone diameter.
+        /// Step of the cones gathering light for the pixels (diffuse, specular, refraction), as a fraction of the cone diameter.
         float step_factor,
+        /// Step of the voxel bounce's diffuse cones, as a fraction of the cone diameter.
+        float bounce_step_factor,
+        /// Step of the soft-shadow cones, as a fraction of the cone diameter.
+        float shadow_step_factor,
         /// tan of half the diffuse cone aperture.
         float diffuse_tan_half,
         /// Cones stop after this distance in world units.
@@ -356,6 +360,10 @@ gpu_layout! {
         uint wide_steps_by_level,
         /// 1: the dense grid's compact pass adds the static meshes' fragment sums (`BINDING_GI_STATIC_SUMS`) to this frame's (a scene with moving meshes, static meshes voxelized once).
         uint static_sums,
+        /// Pads the struct to a multiple of 16 bytes.
+        uint pad0,
+        /// Pads the struct to a multiple of 16 bytes.
+        uint pad1,
     }
 
     /// Head of the occupied-voxel list; the voxels follow as `uint` (x | y << 10 | z << 20).

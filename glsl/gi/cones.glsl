@@ -75,8 +75,10 @@ bool inside_grid(vec3 uvw) {
 // from the one directional volume `ao_volume` (0..5, or -1: none) travelling away from
 // the surface along the axis closest to its normal: the surface's own voxels are hidden
 // from it by the filter's facing weight, whereas the three volumes a slanted cone blends
-// see them edge-on, so an open plane would occlude itself.
-vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surface, vec3 n, int ao_volume) {
+// see them edge-on, so an open plane would occlude itself. Each step is `step_factor` of
+// the cone's diameter there.
+vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surface, vec3 n, int ao_volume,
+                float step_factor) {
     vec4 acc = vec4(0.0);
     float ao = 0.0;
     float ao_alpha = 0.0;
@@ -97,8 +99,8 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surfa
         }
         // Wide cones may instead step level by level: each sample at twice the last's
         // distance, so twice as wide, reading the next coarser level (min_lod marks them).
-        float step_length = (gi.wide_steps_by_level != 0u && min_lod >= 1.0) ? max(dist, diameter * gi.step_factor)
-                                                                              : diameter * gi.step_factor;
+        float step_length = (gi.wide_steps_by_level != 0u && min_lod >= 1.0) ? max(dist, diameter * step_factor)
+                                                                              : diameter * step_factor;
         float next_lod;
         float next_diameter;
         float next_footprint;
@@ -128,7 +130,8 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surfa
 }
 
 // Fraction of the light from `dir` that reaches `origin` through the voxels within
-// `max_dist`: a soft-shadow cone, accumulating opacity only.
+// `max_dist`: a soft-shadow cone, accumulating opacity only, stepping by
+// gi.shadow_step_factor of its diameter.
 float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
     float voxel = gi.origin.w;
     float grid_size = voxel * float(gi.resolution);
@@ -141,8 +144,8 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
             break;
         }
         float s = sample_voxels(uvw, dir, log2(diameter / voxel)).a;
-        float step_length = diameter * gi.step_factor;
-        occlusion += (1.0 - occlusion) * (1.0 - pow(1.0 - clamp(s, 0.0, 0.9999), gi.step_factor));
+        float step_length = diameter * gi.shadow_step_factor;
+        occlusion += (1.0 - occlusion) * (1.0 - pow(1.0 - clamp(s, 0.0, 0.9999), gi.shadow_step_factor));
         dist += step_length;
     }
     return 1.0 - occlusion;
@@ -152,7 +155,7 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
 // from `cones` cones starting at `origin`: one along n, the others in a ring 60 degrees
 // from it. With `with_ao`, alpha is the ambient occlusion (1 where nothing near
 // occludes); else 1.
-vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod, bool with_ao) {
+vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod, bool with_ao, float step_factor) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);
     int ao_volume = -1;
@@ -161,7 +164,7 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
         int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
         ao_volume = 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
     }
-    vec4 centre = trace_cone(origin, n, gi.diffuse_tan_half, min_lod, surface, n, ao_volume);
+    vec4 centre = trace_cone(origin, n, gi.diffuse_tan_half, min_lod, surface, n, ao_volume, step_factor);
     int ring = cones - 1;
     if (ring == 0) {
         return vec4(centre.rgb, 1.0 - centre.a);
@@ -170,7 +173,7 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
     for (int i = 0; i < ring; i++) {
         float phi = 6.2831853 * float(i) / float(ring);
         vec3 dir = normalize(0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b));
-        around += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod, surface, n, ao_volume);
+        around += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod, surface, n, ao_volume, step_factor);
     }
     // Cosine weights: a cone of half-angle 30 degrees at angle a from n holds
     // pi sin^2(30) cos(a) of the cosine-weighted hemisphere: pi/4 along n, pi/8 at 60

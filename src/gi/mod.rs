@@ -105,8 +105,14 @@ pub struct ConeSettings {
     pub diffuse_aperture_deg: f32,
     /// Number of diffuse cones: one along the normal, the rest in a ring at 60 degrees.
     pub diffuse_cones: u32,
-    /// Step length as a fraction of the cone diameter (beta).
+    /// Step length of the cones gathering light for the pixels (diffuse, specular,
+    /// refraction) as a fraction of the cone diameter (beta).
     pub step_factor: f32,
+    /// Step length of the voxel bounce's diffuse cones, as a fraction of the cone
+    /// diameter.
+    pub bounce_step_factor: f32,
+    /// Step length of the soft-shadow cones, as a fraction of the cone diameter.
+    pub shadow_step_factor: f32,
     /// The diffuse cones step level by level (each sample twice as far, so twice as wide)
     /// instead of by `step_factor` of their diameter.
     pub wide_steps_by_level: bool,
@@ -135,6 +141,18 @@ impl ConeSettings {
                 "--diffuse-aperture / diffuse_aperture_deg",
             ),
             (self.step_factor, 0.05, 2.0, "--step-factor / step_factor"),
+            (
+                self.bounce_step_factor,
+                0.05,
+                2.0,
+                "--bounce-step-factor / bounce_step_factor",
+            ),
+            (
+                self.shadow_step_factor,
+                0.05,
+                2.0,
+                "--shadow-step-factor / shadow_step_factor",
+            ),
             (
                 self.shadow_aperture_deg,
                 0.1,
@@ -207,7 +225,9 @@ impl Default for ConeSettings {
         Self {
             diffuse_aperture_deg: 60.0,
             diffuse_cones: 6,
-            step_factor: 0.5,
+            step_factor: 0.25,
+            bounce_step_factor: 0.5,
+            shadow_step_factor: 0.5,
             wide_steps_by_level: false,
             bounces: 8,
             indirect_scale: None,
@@ -732,6 +752,8 @@ impl VoxelGi {
             directional_levels: directional_levels(resolution),
             emission_range: emission_range(scene),
             step_factor: cones.step_factor,
+            bounce_step_factor: cones.bounce_step_factor,
+            shadow_step_factor: cones.shadow_step_factor,
             diffuse_tan_half: (cones.diffuse_aperture_deg.to_radians() * 0.5).tan(),
             max_distance: grid.voxel_size * resolution as f32 * 1.8,
             indirect_scale: 0,
@@ -743,6 +765,8 @@ impl VoxelGi {
                 settings.structure == VoxelStructure::Dense
                     && dense_keeps_static_sums(scene, settings.full_update),
             ),
+            pad0: 0,
+            pad1: 0,
         };
         let uniforms = Buffer::with_data(
             ctx,

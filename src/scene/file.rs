@@ -50,7 +50,9 @@
 //! voxels = 64                    # --voxels
 //! diffuse_cones = 6              # --diffuse-cones
 //! diffuse_aperture_deg = 60.0    # --diffuse-aperture
-//! step_factor = 0.5              # --step-factor
+//! step_factor = 0.25             # --step-factor
+//! bounce_step_factor = 0.5       # --bounce-step-factor
+//! shadow_step_factor = 0.5       # --shadow-step-factor
 //! wide_steps_by_level = false    # --wide-steps-by-level
 //! bounces = 8                    # --bounces
 //! indirect_scale = 2             # --indirect-scale (default: by image height)

@@ -183,6 +183,8 @@ pub struct GiOverrides {
     pub diffuse_cones: Option<u32>,
     pub diffuse_aperture_deg: Option<f32>,
     pub step_factor: Option<f32>,
+    pub bounce_step_factor: Option<f32>,
+    pub shadow_step_factor: Option<f32>,
     pub wide_steps_by_level: Option<bool>,
     pub bounces: Option<u32>,
     pub indirect_scale: Option<u32>,

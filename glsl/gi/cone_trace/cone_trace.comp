@@ -46,7 +46,7 @@ void main() {
     const bool with_ao = false;
 #endif
     vec3 start = p + n * (2.0 * gi.origin.w);
-    imageStore(indirect, low, gather_diffuse(p, start, n, int(gi.diffuse_cones), 1.0, with_ao));
+    imageStore(indirect, low, gather_diffuse(p, start, n, int(gi.diffuse_cones), 1.0, with_ao, gi.step_factor));
     // Soft shadows change at the scale of the voxels, like the indirect light: their
     // cones are traced here too, four lights to a band of rows.
     if ((frame.flags & FLAG_SHADOW_CONES) != 0u) {
@@ -79,7 +79,7 @@ void main() {
         if (traced[c]) {
             // The cone leaves the surface on the side it points to.
             vec3 side = dot(dirs[c], n) < 0.0 ? -n : n;
-            radiance[c] = vec4(trace_cone(p + side * (2.0 * gi.origin.w), dirs[c], roughness, 0.0, p, side, -1).rgb, 1.0);
+            radiance[c] = vec4(trace_cone(p + side * (2.0 * gi.origin.w), dirs[c], roughness, 0.0, p, side, -1, gi.step_factor).rgb, 1.0);
         }
     }
     imageStore(specular, low, radiance[0]);
