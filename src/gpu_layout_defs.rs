@@ -356,7 +356,7 @@ gpu_layout! {
         float shadow_tan_half,
         /// Occluders this far away (world units) occlude half as much as adjacent ones.
         float ao_distance,
-        /// 1: the diffuse (wide) cones step level by level, each sample twice as wide as the last (Dřínovský 2013, 5.6); 0: by `step_factor` of their diameter, as the other cones.
+        /// 1: the diffuse (wide) cones step level by level, each sample twice as wide as the last (Dřínovský 2013, 5.6); 0: by their step factor of their diameter (`step_factor` for the pixels, `bounce_step_factor` in the voxel bounce), as the other cones.
         uint wide_steps_by_level,
         /// 1: the dense grid's compact pass adds the static meshes' fragment sums (`BINDING_GI_STATIC_SUMS`) to this frame's (a scene with moving meshes, static meshes voxelized once).
         uint static_sums,

@@ -153,8 +153,8 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
 
 // Cosine-weighted mean radiance over the hemisphere around n of the surface at `surface`
 // from `cones` cones starting at `origin`: one along n, the others in a ring 60 degrees
-// from it. With `with_ao`, alpha is the ambient occlusion (1 where nothing near
-// occludes); else 1.
+// from it, each stepping `step_factor` of its diameter. With `with_ao`, alpha is the
+// ambient occlusion (1 where nothing near occludes); else 1.
 vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod, bool with_ao, float step_factor) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);

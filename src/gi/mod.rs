@@ -114,7 +114,8 @@ pub struct ConeSettings {
     /// Step length of the soft-shadow cones, as a fraction of the cone diameter.
     pub shadow_step_factor: f32,
     /// The diffuse cones step level by level (each sample twice as far, so twice as wide)
-    /// instead of by `step_factor` of their diameter.
+    /// instead of by `step_factor` (or, in the voxel bounce, `bounce_step_factor`) of
+    /// their diameter.
     pub wide_steps_by_level: bool,
     /// Light bounces between voxels: 1 is direct light on the voxels only.
     pub bounces: u32,
