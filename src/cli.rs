@@ -189,6 +189,13 @@ pub struct RenderArgs {
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
+    /// Anti-aliasing: render the frame N times wider and taller and make each pixel the
+    /// mean of its NxN samples (a box filter over the pixel, as the path-traced
+    /// references use), in linear light; 1 to 4, 1 for one sample per pixel. The indirect
+    /// light's default trace scale follows the larger frame, so it is traced at the same
+    /// resolution as without.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=4))]
+    pub supersample: u32,
 }
 
 #[derive(Args, Debug)]
@@ -258,6 +265,9 @@ pub struct CompareArgs {
     pub blocks: Option<u32>,
 }
 
+/// The largest image side, in pixels, of any frame rendered.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
 /// Parses `WIDTHxHEIGHT`.
 pub fn parse_size(text: &str) -> Result<(u32, u32)> {
     let Some((w, h)) = text.split_once(['x', 'X']) else {
@@ -267,8 +277,8 @@ pub fn parse_size(text: &str) -> Result<(u32, u32)> {
         (Ok(w), Ok(h)) => (w, h),
         _ => bail!("expected WIDTHxHEIGHT with whole numbers, got {text:?}"),
     };
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        bail!("size {w}x{h} is out of range (1..=16384 per side)");
+    if w == 0 || h == 0 || w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE {
+        bail!("size {w}x{h} is out of range (1..={MAX_IMAGE_SIDE} per side)");
     }
     Ok((w, h))
 }

@@ -1,6 +1,7 @@
 //! Reading and writing images: linear EXR radiance and sRGB PNG.
 
 use std::path::Path;
+use std::sync::LazyLock;
 
 use anyhow::{bail, Context as _, Result};
 
@@ -126,6 +127,83 @@ pub fn srgb_encode(x: f32) -> f32 {
     }
 }
 
+/// The inverse of [`srgb_encode`] on [0, 1].
+pub fn srgb_decode(v: f32) -> f32 {
+    let v = v.clamp(0.0, 1.0);
+    if v <= 0.040_45 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Shrinks an RGBA image `width` x `height` by `factor` along each axis, each output
+/// pixel the mean of its `factor` x `factor` block (a box filter). The sizes must be
+/// multiples of `factor`.
+pub fn box_downsample(rgba: &[f32], width: u32, height: u32, factor: u32) -> Vec<f32> {
+    let (w, h, k) = (width as usize, height as usize, factor as usize);
+    assert!(k > 0 && w % k == 0 && h % k == 0 && rgba.len() == w * h * 4);
+    let (out_w, out_h) = (w / k, h / k);
+    let scale = 1.0 / (k * k) as f32;
+    let mut out = vec![0.0; out_w * out_h * 4];
+    for y in 0..h {
+        for x in 0..w {
+            let to = ((y / k) * out_w + x / k) * 4;
+            let from = (y * w + x) * 4;
+            for c in 0..4 {
+                out[to + c] += rgba[from + c] * scale;
+            }
+        }
+    }
+    out
+}
+
+/// A [0, 1] value as a byte, rounded; NaN maps to 0 through the saturating cast.
+pub fn unorm8(x: f32) -> u8 {
+    (x.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// A linear value as an sRGB-encoded byte, computed exactly (a table indexed by the
+/// linear value would lose the dark end).
+pub fn srgb8_encode(x: f32) -> u8 {
+    unorm8(srgb_encode(x))
+}
+
+/// An sRGB-encoded byte as a linear value: a table, as every texel of every albedo
+/// texture's first level passes here.
+pub fn srgb8_decode(byte: u8) -> f32 {
+    static TABLE: LazyLock<[f32; 256]> =
+        LazyLock::new(|| std::array::from_fn(|i| srgb_decode(i as f32 / 255.0)));
+    TABLE[usize::from(byte)]
+}
+
+/// [`box_downsample`] of an 8-bit sRGB-encoded RGBA image, averaging in linear light:
+/// averaging the encoded values would darken every edge.
+pub fn box_downsample_srgb8(rgba8: &[u8], width: u32, height: u32, factor: u32) -> Vec<u8> {
+    let linear: Vec<f32> = rgba8
+        .chunks_exact(4)
+        .flat_map(|p| {
+            [
+                srgb8_decode(p[0]),
+                srgb8_decode(p[1]),
+                srgb8_decode(p[2]),
+                f32::from(p[3]) / 255.0,
+            ]
+        })
+        .collect();
+    box_downsample(&linear, width, height, factor)
+        .chunks_exact(4)
+        .flat_map(|p| {
+            [
+                srgb8_encode(p[0]),
+                srgb8_encode(p[1]),
+                srgb8_encode(p[2]),
+                unorm8(p[3]),
+            ]
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -144,6 +222,50 @@ mod tests {
         assert!((srgb_encode(0.5) - 0.735_356_7).abs() < 1e-5);
         assert!((srgb_encode(1.0) - 1.0).abs() < 1e-6);
         assert_eq!(srgb_encode(7.0), srgb_encode(1.0));
+    }
+
+    #[test]
+    fn srgb_decode_inverts_encode() {
+        for i in 0..=100 {
+            let x = i as f32 / 100.0;
+            assert!((srgb_decode(srgb_encode(x)) - x).abs() < 1e-5, "{x}");
+        }
+        assert_eq!(srgb_decode(2.0), 1.0);
+    }
+
+    #[test]
+    fn srgb_round_trips_every_byte() {
+        for b in 0..=255u8 {
+            assert_eq!(srgb8_encode(srgb8_decode(b)), b);
+        }
+        assert_eq!(srgb8_encode(f32::NAN), 0);
+        assert_eq!(srgb8_encode(7.0), 255);
+    }
+
+    #[test]
+    fn box_downsample_means_each_block() {
+        // 4x2 pixels, factor 2: two output pixels, each the mean of a 2x2 block.
+        let rgba: Vec<f32> = (0..8)
+            .flat_map(|i| [i as f32, 1.0, 2.0 * i as f32, 1.0])
+            .collect();
+        let out = box_downsample(&rgba, 4, 2, 2);
+        // Block one holds pixels 0, 1, 4, 5; block two 2, 3, 6, 7.
+        assert_eq!(out, vec![2.5, 1.0, 5.0, 1.0, 4.5, 1.0, 9.0, 1.0]);
+        assert_eq!(box_downsample(&rgba, 4, 2, 1), rgba);
+    }
+
+    #[test]
+    fn srgb8_downsample_averages_in_linear_light() {
+        // Black and white side by side: half the light, encoded 188, not the encoded
+        // values' mean 128.
+        let rgba8 = [0, 0, 0, 255, 255, 255, 255, 255];
+        let out = box_downsample_srgb8(&rgba8, 2, 1, 1);
+        assert_eq!(out, rgba8.to_vec());
+        let rgba8 = [
+            0, 0, 0, 255, 255, 255, 255, 255, 0, 0, 0, 255, 255, 255, 255, 255,
+        ];
+        let out = box_downsample_srgb8(&rgba8, 2, 2, 2);
+        assert_eq!(out, vec![188, 188, 188, 255]);
     }
 
     #[test]

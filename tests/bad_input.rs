@@ -112,6 +112,18 @@ fn unknown_gi_mode() {
 }
 
 #[test]
+fn supersampled_frame_too_large() {
+    assert_fails_naming(
+        &["render", "--size", "10000x100", "--supersample", "2"],
+        &["10000x100", "--supersample 2", "20000x200", "16384"],
+    );
+    assert_fails_naming(
+        &["render", "--supersample", "5"],
+        &["--supersample", "1..=4"],
+    );
+}
+
+#[test]
 fn bad_output_extension() {
     assert_fails_naming(
         &["render", "-o", "picture.bmp"],

@@ -7,7 +7,8 @@ use anyhow::{bail, Context as _, Result};
 use ash::vk;
 
 use super::{check_validation, create_context, load_scene, Offscreen};
-use crate::cli::RenderArgs;
+use crate::cli::{RenderArgs, MAX_IMAGE_SIDE};
+use crate::imageio::{box_downsample, box_downsample_srgb8};
 use crate::renderer::{copy_image_to_buffer, OutputTarget, Renderer};
 use crate::vk::{Buffer, ImageUse};
 
@@ -35,13 +36,20 @@ fn output_format(path: &Path) -> Result<Format> {
 /// Renders one frame and writes it; returns the path written.
 pub fn run(args: &RenderArgs) -> Result<PathBuf> {
     let format = output_format(&args.output)?;
+    let samples = args.supersample;
+    let (width, height) = (args.size.0 * samples, args.size.1 * samples);
+    if width.max(height) > MAX_IMAGE_SIDE {
+        bail!(
+            "--size {}x{} with --supersample {samples} renders {width}x{height}, over {MAX_IMAGE_SIDE} \
+             pixels per side: lower one of them",
+            args.size.0,
+            args.size.1
+        );
+    }
     let ctx = create_context(&args.common, Vec::new())?;
     let scene = load_scene(&args.common)?;
     let settings = args.common.render_settings(&scene.gi)?;
-    let extent = vk::Extent2D {
-        width: args.size.0,
-        height: args.size.1,
-    };
+    let extent = vk::Extent2D { width, height };
     let offscreen = Offscreen::new(&ctx, extent)?;
     let mut renderer = Renderer::new(&ctx, scene, settings, extent, super::LDR_FORMAT)?;
     let radiance = Buffer::new(
@@ -74,9 +82,9 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
     renderer.submit(frame, None, None)?;
     renderer.finish()?;
     log::info!(
-        "rendered {}x{} in {:.1} ms (GPU: {})",
-        extent.width,
-        extent.height,
+        "rendered {}x{} ({samples}x{samples} samples per pixel) in {:.1} ms (GPU: {})",
+        args.size.0,
+        args.size.1,
         start.elapsed().as_secs_f64() * 1e3,
         renderer
             .timings
@@ -85,17 +93,17 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
             .collect::<Vec<_>>()
             .join(", ")
     );
+    let (out_width, out_height) = args.size;
     match format {
         Format::Exr => {
             let data: &[f32] = bytemuck::cast_slice(radiance.mapped());
-            crate::imageio::write_exr(&args.output, extent.width, extent.height, data)
+            let data = box_downsample(data, width, height, samples);
+            crate::imageio::write_exr(&args.output, out_width, out_height, &data)
         }
-        Format::Png => crate::imageio::write_png(
-            &args.output,
-            extent.width,
-            extent.height,
-            offscreen.readback.mapped(),
-        ),
+        Format::Png => {
+            let data = box_downsample_srgb8(offscreen.readback.mapped(), width, height, samples);
+            crate::imageio::write_png(&args.output, out_width, out_height, &data)
+        }
     }
     .with_context(|| format!("writing {}", args.output.display()))?;
     check_validation(&ctx)?;

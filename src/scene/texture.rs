@@ -4,11 +4,12 @@
 //! is meaningful: albedo in linear light, normals as unit vectors.
 
 use std::path::{Path, PathBuf};
-use std::sync::LazyLock;
 
 use anyhow::{ensure, Context as _, Result};
 use glam::{Vec3, Vec4};
 use image::DynamicImage;
+
+use crate::imageio::{srgb8_decode, srgb8_encode, unorm8};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TextureKind {
@@ -85,7 +86,7 @@ fn rgba32f_to_srgb8(image: &DynamicImage) -> Vec<u8> {
         .pixels()
         .flat_map(|p| {
             let [r, g, b, a] = p.0;
-            [srgb_encode(r), srgb_encode(g), srgb_encode(b), unorm8(a)]
+            [srgb8_encode(r), srgb8_encode(g), srgb8_encode(b), unorm8(a)]
         })
         .collect()
 }
@@ -106,41 +107,12 @@ fn coverage(image: &DynamicImage) -> Vec<u8> {
         .collect()
 }
 
-/// sRGB byte to linear value: a table, as every texel of every albedo level-0 passes here.
-static SRGB_TO_LINEAR: LazyLock<[f32; 256]> = LazyLock::new(|| {
-    std::array::from_fn(|i| {
-        let c = i as f32 / 255.0;
-        if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    })
-});
-
-/// Linear value to sRGB byte, computed exactly (a table indexed by the linear value would
-/// lose the dark end).
-fn srgb_encode(x: f32) -> u8 {
-    let x = x.clamp(0.0, 1.0);
-    let s = if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    };
-    unorm8(s)
-}
-
-fn unorm8(x: f32) -> u8 {
-    // NaN maps to 0 through the saturating cast.
-    (x.clamp(0.0, 1.0) * 255.0).round() as u8
-}
-
 fn decode(kind: TextureKind, p: &[u8]) -> Vec4 {
     match kind {
         TextureKind::Albedo => Vec4::new(
-            SRGB_TO_LINEAR[p[0] as usize],
-            SRGB_TO_LINEAR[p[1] as usize],
-            SRGB_TO_LINEAR[p[2] as usize],
+            srgb8_decode(p[0]),
+            srgb8_decode(p[1]),
+            srgb8_decode(p[2]),
             f32::from(p[3]) / 255.0,
         ),
         TextureKind::Coverage => unorm_vec4(p),
@@ -158,9 +130,9 @@ fn unorm_vec4(p: &[u8]) -> Vec4 {
 fn encode(kind: TextureKind, v: Vec4) -> [u8; 4] {
     match kind {
         TextureKind::Albedo => [
-            srgb_encode(v.x),
-            srgb_encode(v.y),
-            srgb_encode(v.z),
+            srgb8_encode(v.x),
+            srgb8_encode(v.y),
+            srgb8_encode(v.z),
             unorm8(v.w),
         ],
         TextureKind::Coverage => v.to_array().map(unorm8),
@@ -244,15 +216,6 @@ mod tests {
         // Linear 0.5 is sRGB 0.7354, byte 188 (a gamma-space average would give 128).
         assert_eq!(t.mips[1], [188, 188, 188, 255].repeat(4));
         assert_eq!(t.mips[2], [188, 188, 188, 255]);
-    }
-
-    #[test]
-    fn srgb_round_trips_every_byte() {
-        for b in 0..=255u8 {
-            assert_eq!(srgb_encode(SRGB_TO_LINEAR[b as usize]), b);
-        }
-        assert_eq!(srgb_encode(f32::NAN), 0);
-        assert_eq!(srgb_encode(7.0), 255);
     }
 
     #[test]
