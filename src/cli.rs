@@ -193,7 +193,7 @@ pub struct RenderArgs {
     /// mean of its NxN samples (a box filter over the pixel, as the path-traced
     /// references use), in linear light; 1 to 4, 1 for one sample per pixel. The indirect
     /// light's default trace scale follows the larger frame, so it is traced at the same
-    /// resolution as without.
+    /// resolution as without (an explicit --indirect-scale counts the larger frame's pixels).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=4))]
     pub supersample: u32,
 }
