@@ -177,30 +177,36 @@ pub fn srgb8_decode(byte: u8) -> f32 {
     TABLE[usize::from(byte)]
 }
 
+/// An RGBA8 pixel with sRGB-encoded colour and linear alpha, in linear values.
+pub fn srgba8_decode(p: [u8; 4]) -> [f32; 4] {
+    [
+        srgb8_decode(p[0]),
+        srgb8_decode(p[1]),
+        srgb8_decode(p[2]),
+        f32::from(p[3]) / 255.0,
+    ]
+}
+
+/// The inverse of [`srgba8_decode`].
+pub fn srgba8_encode(v: [f32; 4]) -> [u8; 4] {
+    [
+        srgb8_encode(v[0]),
+        srgb8_encode(v[1]),
+        srgb8_encode(v[2]),
+        unorm8(v[3]),
+    ]
+}
+
 /// [`box_downsample`] of an 8-bit sRGB-encoded RGBA image, averaging in linear light:
 /// averaging the encoded values would darken every edge.
 pub fn box_downsample_srgb8(rgba8: &[u8], width: u32, height: u32, factor: u32) -> Vec<u8> {
     let linear: Vec<f32> = rgba8
         .chunks_exact(4)
-        .flat_map(|p| {
-            [
-                srgb8_decode(p[0]),
-                srgb8_decode(p[1]),
-                srgb8_decode(p[2]),
-                f32::from(p[3]) / 255.0,
-            ]
-        })
+        .flat_map(|p| srgba8_decode([p[0], p[1], p[2], p[3]]))
         .collect();
     box_downsample(&linear, width, height, factor)
         .chunks_exact(4)
-        .flat_map(|p| {
-            [
-                srgb8_encode(p[0]),
-                srgb8_encode(p[1]),
-                srgb8_encode(p[2]),
-                unorm8(p[3]),
-            ]
-        })
+        .flat_map(|v| srgba8_encode([v[0], v[1], v[2], v[3]]))
         .collect()
 }
 

@@ -9,7 +9,7 @@ use anyhow::{ensure, Context as _, Result};
 use glam::{Vec3, Vec4};
 use image::DynamicImage;
 
-use crate::imageio::{srgb8_decode, srgb8_encode, unorm8};
+use crate::imageio::{srgba8_decode, srgba8_encode, unorm8};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TextureKind {
@@ -84,10 +84,7 @@ fn rgba32f_to_srgb8(image: &DynamicImage) -> Vec<u8> {
     image
         .to_rgba32f()
         .pixels()
-        .flat_map(|p| {
-            let [r, g, b, a] = p.0;
-            [srgb8_encode(r), srgb8_encode(g), srgb8_encode(b), unorm8(a)]
-        })
+        .flat_map(|p| srgba8_encode(p.0))
         .collect()
 }
 
@@ -109,12 +106,7 @@ fn coverage(image: &DynamicImage) -> Vec<u8> {
 
 fn decode(kind: TextureKind, p: &[u8]) -> Vec4 {
     match kind {
-        TextureKind::Albedo => Vec4::new(
-            srgb8_decode(p[0]),
-            srgb8_decode(p[1]),
-            srgb8_decode(p[2]),
-            f32::from(p[3]) / 255.0,
-        ),
+        TextureKind::Albedo => Vec4::from_array(srgba8_decode([p[0], p[1], p[2], p[3]])),
         TextureKind::Coverage => unorm_vec4(p),
         TextureKind::Normal => {
             let v = unorm_vec4(p);
@@ -129,12 +121,7 @@ fn unorm_vec4(p: &[u8]) -> Vec4 {
 
 fn encode(kind: TextureKind, v: Vec4) -> [u8; 4] {
     match kind {
-        TextureKind::Albedo => [
-            srgb8_encode(v.x),
-            srgb8_encode(v.y),
-            srgb8_encode(v.z),
-            unorm8(v.w),
-        ],
+        TextureKind::Albedo => srgba8_encode(v.to_array()),
         TextureKind::Coverage => v.to_array().map(unorm8),
         TextureKind::Normal => {
             let n = v.truncate() * 0.5 + 0.5;
