@@ -5,6 +5,13 @@
 #include "common/frame.glsl"
 #include "gi/sampling.glsl"
 
+// Per axis, the share of a cell of directional `level` centred at `uvw` (two cells
+// wide: the trilinear tent) that lies inside the grid.
+vec3 cross_section_inside(vec3 uvw, float level) {
+    float h = exp2(max(level, 0.0)) / float(gi.resolution);
+    return clamp((min(uvw + h, 1.0) - max(uvw - h, 0.0)) / (2.0 * h), 0.0, 1.0);
+}
+
 // Voxel radiance at `uvw` for a cone travelling along `dir`, from the three directional
 // volumes facing the cone at mip `level`, weighted by the squared direction components
 // w. The optical depths add up, weighted by w, so the transmittance is the product of
@@ -12,12 +19,20 @@
 // crosses it, where a weighted mean of the opacities would let a cone at 45 degrees see
 // half through it (and light leave the room). The colour is the opacity-weighted mean
 // of the three.
+// Each volume is weighted by the share of the cell's cross-section across its axis that
+// lies inside the grid: the grid covers the scene, so nothing lies beyond its faces,
+// where the clamped lookup would repeat the edge cells (the walls and floor at an open
+// side of the scene, as if they went on).
 vec4 sample_directional_volumes(vec3 uvw, vec3 dir, float level) {
     vec3 w = dir * dir;
     vec4 sx;
     vec4 sy;
     vec4 sz;
     sample_facing(uvw, dir, level, sx, sy, sz);
+    vec3 inside = cross_section_inside(uvw, level);
+    sx *= inside.y * inside.z;
+    sy *= inside.x * inside.z;
+    sz *= inside.x * inside.y;
     vec4 mean = w.x * sx + w.y * sy + w.z * sz;
     vec3 transmittance = 1.0 - clamp(vec3(sx.a, sy.a, sz.a), 0.0, 0.9999);
     float alpha = 1.0 - exp2(dot(w, log2(transmittance)));
@@ -68,6 +83,24 @@ bool inside_grid(vec3 uvw) {
     return all(greaterThanEqual(uvw, vec3(0.0))) && all(lessThanEqual(uvw, vec3(1.0)));
 }
 
+// Where the segment from `a` (inside the grid) to `b` (outside) crosses the grid's
+// faces, as a fraction of the segment.
+float grid_exit(vec3 a, vec3 b) {
+    vec3 span = b - a;
+    vec3 low = mix(vec3(1e9), -a / span, lessThan(b, vec3(0.0)));
+    vec3 high = mix(vec3(1e9), (1.0 - a) / span, greaterThan(b, vec3(1.0)));
+    vec3 t = min(low, high);
+    return clamp(min(t.x, min(t.y, t.z)), 0.0, 1.0);
+}
+
+// The path, in footprints, that the grid's face counts where a cone leaves the grid.
+// The scene's bounds often lie on a wall (a room's), whose voxels fill the grid's last
+// layer; with linear interpolation of opacity the march integrates only the inner half
+// of that layer's tent, and the wall would let about a tenth of the light through. Half
+// a footprint stands for the outer half; measured (LDR-FLIP Cornell box 0.1168 / 0.1149
+// / 0.1165 / 0.1198 / 0.1307 at 0.4 / 0.5 / 0.6 / 0.7 / 1; BENCHMARKS.md, session 10).
+const float GRID_FACE_PATH = 0.5;
+
 // Front-to-back accumulation along one cone leaving the surface at `surface` with normal
 // `n`; returns premultiplied radiance (rgb) with the sky behind whatever the cone leaves
 // open, and (a) the occlusion that ambient occlusion counts, each occluder weighted down
@@ -87,6 +120,7 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surfa
     float diameter;
     float footprint;
     vec3 uvw = cone_sample(origin, dir, dist, tan_half, min_lod, surface, n, lod, diameter, footprint);
+    bool at_face = false;
     while (acc.a < 0.99 && dist < gi.max_distance && inside_grid(uvw)) {
         // Cones that never sample below lod 1 (the diffuse ones) skip the base level: the
         // branch is on a constant once inlined, where testing lod per sample cost more
@@ -107,17 +141,38 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surfa
         vec3 next_uvw = cone_sample(origin, dir, dist + step_length, tan_half, min_lod, surface, n, next_lod,
                                     next_diameter, next_footprint);
         // Opacity was filtered for a path of one footprint; correct it to the path from
-        // this sample to the next: the step, longer where the lift bends it.
-        float path = distance(next_uvw, uvw) * gi.origin.w * float(gi.resolution);
-        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), path / footprint);
+        // this sample to the next: the step, longer where the lift bends it. The last
+        // step inside the grid ends at its face, so that what a cone gathers changes
+        // smoothly as its origin moves (a whole step there drew bands in the indirect
+        // light wherever one more sample fell inside the grid).
+        bool leaving = !inside_grid(next_uvw);
+        float exit_fraction = leaving ? grid_exit(uvw, next_uvw) : 1.0;
+        float path = distance(next_uvw, uvw) * gi.origin.w * float(gi.resolution) * exit_fraction;
+        float footprints = at_face ? GRID_FACE_PATH : path / footprint;
+        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), footprints);
         vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
         acc.rgb += (1.0 - acc.a) * rgb;
         acc.a += (1.0 - acc.a) * a;
         if (ao_volume >= 0) {
             float o = sample_directional(ao_volume, uvw, max(lod - 1.0, 0.0)).a;
-            o = 1.0 - pow(1.0 - clamp(o, 0.0, 0.9999), path / footprint);
+            o = 1.0 - pow(1.0 - clamp(o, 0.0, 0.9999), footprints);
             ao += (1.0 - ao_alpha) * o / (1.0 + dist / gi.ao_distance);
             ao_alpha += (1.0 - ao_alpha) * o;
+        }
+        if (at_face) {
+            break;
+        }
+        if (leaving) {
+            // One more sample, in the same loop (a separate fetch after it cost lavapipe
+            // as much as a step for every lane, on each step where any lane left): the
+            // face itself, what lies in it (a wall on the scene's bounds) for
+            // GRID_FACE_PATH footprints, read one level finer than the cone, so that
+            // walls running along the cone to an open face (a corridor's) count as the
+            // small share of the cell they are.
+            at_face = true;
+            uvw = clamp(mix(uvw, next_uvw, exit_fraction), 0.0, 1.0);
+            lod = max(lod - 1.0, min_lod);
+            continue;
         }
         dist += step_length;
         uvw = next_uvw;
