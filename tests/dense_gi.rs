@@ -54,8 +54,13 @@ fn cornell_point_dense_gi() {
     let flip_dense = compare(&reference, &dense, &CompareOptions::default())
         .unwrap()
         .flip_ldr;
-    eprintln!("LDR-FLIP against cornell_point: --gi off {flip_off:.3}, --gi dense {flip_dense:.3}");
-    // Measured 0.591 and 0.132; the target for dense is 0.10 (not reached yet).
+    eprintln!("LDR-FLIP against cornell_point: --gi off {flip_off:.4}, --gi dense {flip_dense:.4}");
+    // Measured 0.5911 and 0.1149 (BENCHMARKS.md); the target for dense is 0.10, not reached
+    // yet. The bound guards what is reached: a change that costs a tenth of it fails.
+    assert!(
+        flip_dense <= 0.125,
+        "LDR-FLIP {flip_dense:.4} against cornell_point, measured 0.1149"
+    );
     assert!(
         flip_dense < flip_off - 0.25,
         "indirect light does not bring the image closer"
@@ -74,6 +79,35 @@ fn cornell_point_dense_gi() {
         red_dense - green_dense > red_off - green_off + 0.005,
         "indirect light adds no colour bleeding"
     );
+}
+
+/// Sponza and Sibenik at default settings against their references: the quality targets
+/// (LDR-FLIP 0.15 each) hold, Sibenik's with the margin it has (measured 0.1401 and
+/// 0.0862, BENCHMARKS.md).
+#[test]
+fn sponza_and_sibenik_meet_quality_targets() {
+    let Some(shared) = shared() else { return };
+    let dir = temp_dir("dense_gi_quality");
+    for (name, bound) in [("sponza_main", 0.15), ("sibenik_main", 0.10)] {
+        let out = dir.join(format!("{name}.exr"));
+        render(
+            &shared.join(format!("reference/{name}.scene.json")),
+            "dense",
+            &out,
+        );
+        let flip = compare(
+            &shared.join(format!("reference/{name}.exr")),
+            &out,
+            &CompareOptions::default(),
+        )
+        .unwrap()
+        .flip_ldr;
+        eprintln!("LDR-FLIP against {name}: {flip:.4}");
+        assert!(
+            flip <= bound,
+            "LDR-FLIP {flip:.4} against {name}, bound {bound}"
+        );
+    }
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
