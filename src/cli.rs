@@ -112,13 +112,13 @@ pub struct CommonArgs {
     /// last (Dřínovský's sampling of wide cones), instead of by the step factor.
     #[arg(long)]
     pub wide_steps_by_level: bool,
-    /// Diffuse cones per gather, 1 to 16: one along the normal, the rest in a ring at 60
-    /// degrees [default: 6].
+    /// Diffuse cones per gather, 1 to 16: one along the normal, the rest in a ring at 57.5
+    /// degrees, each traced on screen as narrower sub-cones [default: 6].
     #[arg(long)]
     pub diffuse_cones: Option<u32>,
     /// Trace the cones (indirect light, soft shadows, specular, refraction) on one pixel of
     /// each NxN block and upsample, 1 to 8
-    /// [default: height / 128, at least 2: 5 at 720 rows].
+    /// [default: height / 64, 2 to 8: 4 at 256 rows, 8 at 512 and above].
     #[arg(long)]
     pub indirect_scale: Option<u32>,
     /// Recompute every bounce every frame, instead of adding one bounce per frame to the

@@ -350,7 +350,7 @@ gpu_layout! {
         float max_distance,
         /// Indirect light is traced on one pixel of each `indirect_scale`² block.
         uint indirect_scale,
-        /// Cones of the diffuse gather: one along the normal, the rest in a ring at 60 degrees.
+        /// Cones of the diffuse gather: one along the normal, the rest in a ring at 57.5 degrees.
         uint diffuse_cones,
         /// tan of half the aperture of the soft-shadow cones.
         float shadow_tan_half,

@@ -55,11 +55,10 @@ fn cornell_point_dense_gi() {
         .unwrap()
         .flip_ldr;
     eprintln!("LDR-FLIP against cornell_point: --gi off {flip_off:.4}, --gi dense {flip_dense:.4}");
-    // Measured 0.5911 and 0.1149 (BENCHMARKS.md); the target for dense is 0.10, not reached
-    // yet. The bound guards what is reached: a change that costs a tenth of it fails.
+    // Measured 0.5911 and 0.0992 (BENCHMARKS.md); the target for dense is 0.10.
     assert!(
-        flip_dense <= 0.125,
-        "LDR-FLIP {flip_dense:.4} against cornell_point, measured 0.1149"
+        flip_dense <= 0.10,
+        "LDR-FLIP {flip_dense:.4} against cornell_point, measured 0.0992"
     );
     assert!(
         flip_dense < flip_off - 0.25,
@@ -82,8 +81,8 @@ fn cornell_point_dense_gi() {
 }
 
 /// Sponza and Sibenik at default settings against their references: the quality targets
-/// (LDR-FLIP 0.15 each) hold, Sibenik's with the margin it has (measured 0.1401 and
-/// 0.0862, BENCHMARKS.md).
+/// (LDR-FLIP 0.15 each) hold, Sibenik's with the margin it has (measured 0.1414 and
+/// 0.0864, BENCHMARKS.md).
 #[test]
 fn sponza_and_sibenik_meet_quality_targets() {
     let Some(shared) = shared() else { return };

@@ -53,7 +53,7 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
 // Where a cone leaving the surface at `surface` with normal `n` samples at distance
 // `dist` from `origin` (texture coordinates), with the cone `diameter` there (which sets
 // the step) and the `footprint` the sample reads at (mip `lod`).
-// A cone 60 degrees off the normal with a 30 degree half-angle grazes the surface's own
+// A cone 57.5 degrees off the normal with a 30 degree half-angle nearly grazes the surface's own
 // plane, and the trilinear lookup blends cells up to one cell size from the sample
 // point: the surface would occlude and light itself (its lit voxels seen edge-on).
 // So the footprint is capped at the sample's height above the plane, and a sample less
@@ -97,9 +97,10 @@ float grid_exit(vec3 a, vec3 b) {
 // The scene's bounds often lie on a wall (a room's), whose voxels fill the grid's last
 // layer; with linear interpolation of opacity the march integrates only the inner half
 // of that layer's tent, and the wall would let about a tenth of the light through. Half
-// a footprint stands for the outer half; measured (LDR-FLIP Cornell box 0.1168 / 0.1149
-// / 0.1165 / 0.1198 / 0.1307 at 0.4 / 0.5 / 0.6 / 0.7 / 1; BENCHMARKS.md, session 10).
-const float GRID_FACE_PATH = 0.5;
+// a footprint stands for the outer half; measured with the screen's ring cones traced
+// as sub-cones (LDR-FLIP Cornell box 0.1138 / 0.0996 / 0.0991 / 0.1046 / 0.1133 at 0.35
+// / 0.5 / 0.65 / 0.8 / 1; BENCHMARKS.md, sessions 10 and 11).
+const float GRID_FACE_PATH = 0.65;
 
 // Front-to-back accumulation along one cone leaving the surface at `surface` with normal
 // `n`; returns premultiplied radiance (rgb) with the sky behind whatever the cone leaves
@@ -206,11 +207,49 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
     return 1.0 - occlusion;
 }
 
+// The screen's ring cones are each traced as sub-cones, narrower cones around their
+// axis that read finer levels: a 60-degree cone leaving a surface blends, in its coarse
+// cells, the surface's own lit voxels and walls seen edge-on that its rays never meet,
+// and a narrower cone blends less of them (per cone against the exact cone integrals,
+// BENCHMARKS.md, session 11). About 20 sub-cones go round the ring whatever its count
+// (the ring cones overlap more as there are more of them): four per cone up to five
+// cones (each 0.53 as wide, 0.47 of the half-angle off the axis, in a square around
+// it), two up to ten (0.63 as wide, 0.4 off), else none. They step as far as the cone
+// they stand for, so a sub-cone costs about one cone (LDR-FLIP Cornell box 0.1149 ->
+// 0.0996 with the ring at 57.5 degrees; 0.0987 with sub-cones stepping by their own
+// width, at twice the cost; two sub-cones per cone: 0.106; three: 0.102; at 60 degrees,
+// the centre cone split as well: 0.106 against 0.101).
+vec4 trace_ring_cone(vec3 origin, vec3 dir, int ring, float min_lod, vec3 surface, vec3 n, float step_factor,
+                     int ao_volume) {
+    int parts = ring <= 5 ? 4 : (ring <= 10 ? 2 : 1);
+    if (parts == 1) {
+        return trace_cone(origin, dir, gi.diffuse_tan_half, min_lod, surface, n, ao_volume, step_factor);
+    }
+    float offset = atan(gi.diffuse_tan_half) * (parts == 4 ? 0.467 : 0.4);
+    float tan_half = gi.diffuse_tan_half * (parts == 4 ? 0.53 : 0.63);
+    vec3 along = normalize(abs(dir.y) < 0.9 ? cross(dir, vec3(0.0, 1.0, 0.0)) : cross(dir, vec3(1.0, 0.0, 0.0)));
+    vec3 across = cross(dir, along);
+    vec4 sum = vec4(0.0);
+    for (int i = 0; i < parts; i++) {
+        float phi = 6.2831853 * (float(i) + 0.5) / float(parts);
+        vec3 d = normalize(cos(offset) * dir + sin(offset) * (cos(phi) * along + sin(phi) * across));
+        sum += trace_cone(origin, d, tan_half, min_lod, surface, n, ao_volume,
+                          step_factor * gi.diffuse_tan_half / tan_half);
+    }
+    return sum / float(parts);
+}
+
 // Cosine-weighted mean radiance over the hemisphere around n of the surface at `surface`
-// from `cones` cones starting at `origin`: one along n, the others in a ring 60 degrees
-// from it, each stepping `step_factor` of its diameter. With `with_ao`, alpha is the
-// ambient occlusion (1 where nothing near occludes); else 1.
-vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod, bool with_ao, float step_factor) {
+// from `cones` cones starting at `origin`: one along n, the others in a ring 57.5 degrees
+// from it (traced as sub-cones where `split_ring`: the screen's), each stepping
+// `step_factor` of its diameter. With `with_ao`, alpha is the ambient occlusion (1 where
+// nothing near occludes); else 1.
+// The ring at 57.5 degrees: with the exact cone integrals the best ring is 50-55 degrees
+// (the cosine-weighted mean direction of the band it stands for is 54.7), but the traced
+// cones read their ring best at 57.5 (LDR-FLIP Cornell box 0.1023 / 0.0996 / 0.1003 /
+// 0.1012 at 54.7 / 57.5 / 59 / 60 degrees, with sub-cones).
+vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod, bool with_ao, float step_factor,
+                    bool split_ring) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);
     int ao_volume = -1;
@@ -227,14 +266,16 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
     vec4 around = vec4(0.0);
     for (int i = 0; i < ring; i++) {
         float phi = 6.2831853 * float(i) / float(ring);
-        vec3 dir = normalize(0.5 * n + 0.8660254 * (cos(phi) * t + sin(phi) * b));
-        around += trace_cone(origin, dir, gi.diffuse_tan_half, min_lod, surface, n, ao_volume, step_factor);
+        vec3 dir = normalize(0.5373 * n + 0.8434 * (cos(phi) * t + sin(phi) * b));
+        around += trace_ring_cone(origin, dir, split_ring ? ring : 1000, min_lod, surface, n, step_factor,
+                                  ao_volume);
     }
     // Cosine weights: a cone of half-angle 30 degrees at angle a from n holds
-    // pi sin^2(30) cos(a) of the cosine-weighted hemisphere: pi/4 along n, pi/8 at 60
-    // degrees. Five such cones fill the ring at 60 degrees; more overlap and share the
-    // ring's pi * 5/8, so its share does not grow with the count (the gaps towards the
-    // horizon are filled in proportion).
+    // pi sin^2(30) cos(a) of the cosine-weighted hemisphere: pi/4 along n, about pi/8 in
+    // the ring. Five such cones fill the ring; more overlap and share the ring's
+    // pi * 5/8, so its share does not grow with the count (the gaps towards the horizon
+    // are filled in proportion). (The band's own share, 3/4 against the cap's 1/4, scores
+    // worse with the traced cones: 0.1039 against 0.1023 at 54.7 degrees.)
     float ring_share = 0.5 * float(min(ring, 5));
     vec4 sum = (centre + ring_share * around / float(ring)) / (1.0 + ring_share);
     return vec4(sum.rgb, 1.0 - sum.a);

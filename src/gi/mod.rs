@@ -103,7 +103,7 @@ fn to_compute_write(ctx: &Arc<Context>, name: &str, images: &[&Image]) -> Result
 pub struct ConeSettings {
     /// Full aperture of the diffuse cones, degrees.
     pub diffuse_aperture_deg: f32,
-    /// Number of diffuse cones: one along the normal, the rest in a ring at 60 degrees.
+    /// Number of diffuse cones: one along the normal, the rest in a ring at 57.5 degrees.
     pub diffuse_cones: u32,
     /// Step length of the cones gathering light for the pixels (diffuse, specular,
     /// refraction) as a fraction of the cone diameter (beta).
@@ -192,12 +192,15 @@ impl ConeSettings {
 }
 
 /// The default reduction of the indirect light's resolution for an image `height` pixels
-/// high: height / 128 (at least 2), so that it is traced on 128 to 255 rows whatever the
-/// image size (2 at 256 rows, where the quality is measured against the references; 5 at
-/// 720). Indirect diffuse light and soft shadows vary at the scale of the voxels, not of
-/// the pixels.
+/// high: height / 64 (2 to 8), so that it is traced on 64 to 127 rows up to 511 rows and
+/// at an eighth above (2 at 128 rows; 4 at 256; 8 at 512, where `render`'s 2x2 samples
+/// measure the quality against the references, and at 720). Indirect diffuse light and
+/// soft shadows vary at the scale of the voxels, not of the pixels: at 512 rows LDR-FLIP
+/// against the references is 0.0992 / 0.1414 / 0.0864 with 8 (Cornell / Sponza /
+/// Sibenik) and 0.0990 / 0.1393 / 0.0848 with 4, and the speed case (`bench`, 720 rows,
+/// nine cones) fits its budget.
 pub fn auto_indirect_scale(height: u32) -> u32 {
-    (height / 128).clamp(2, 8)
+    (height / 64).clamp(2, 8)
 }
 
 /// The scene's largest emitted radiance: voxels store emission divided by it, in RGBA8.

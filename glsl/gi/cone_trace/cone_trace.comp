@@ -46,7 +46,7 @@ void main() {
     const bool with_ao = false;
 #endif
     vec3 start = p + n * (2.0 * gi.origin.w);
-    imageStore(indirect, low, gather_diffuse(p, start, n, int(gi.diffuse_cones), 1.0, with_ao, gi.step_factor));
+    imageStore(indirect, low, gather_diffuse(p, start, n, int(gi.diffuse_cones), 1.0, with_ao, gi.step_factor, true));
     // Soft shadows change at the scale of the voxels, like the indirect light: their
     // cones are traced here too, four lights to a band of rows.
     if ((frame.flags & FLAG_SHADOW_CONES) != 0u) {
