@@ -208,6 +208,12 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
     return 1.0 - occlusion;
 }
 
+// A unit vector perpendicular to the unit vector `axis` (from the world's y axis, or x
+// where `axis` nearly is y): with cross(axis, it), the frame that cones are laid out in.
+vec3 perpendicular(vec3 axis) {
+    return normalize(abs(axis.y) < 0.9 ? cross(axis, vec3(0.0, 1.0, 0.0)) : cross(axis, vec3(1.0, 0.0, 0.0)));
+}
+
 // The screen's ring cones are each traced as sub-cones, narrower cones around their
 // axis that read finer levels: a 60-degree cone leaving a surface blends, in its coarse
 // cells, the surface's own lit voxels and walls seen edge-on that its rays never meet,
@@ -230,7 +236,7 @@ vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surfa
     // Evenly round the axis, half a step off a frame fixed to the world's y axis (the
     // square along and across the ring instead: 0.1006 against 0.1007 at 60 degrees; nine
     // cones with their pairs along the ring instead: 0.110 against 0.104).
-    vec3 u = normalize(abs(dir.y) < 0.9 ? cross(dir, vec3(0.0, 1.0, 0.0)) : cross(dir, vec3(1.0, 0.0, 0.0)));
+    vec3 u = perpendicular(dir);
     vec3 v = cross(dir, u);
     vec4 sum = vec4(0.0);
     for (int i = 0; i < parts; i++) {
@@ -253,7 +259,7 @@ vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surfa
 // 0.1012 at 54.7 / 57.5 / 59 / 60 degrees, with sub-cones).
 vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod, bool with_ao, float step_factor,
                     bool split_ring) {
-    vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
+    vec3 t = perpendicular(n);
     vec3 b = cross(n, t);
     int ao_volume = -1;
     if (with_ao) {
