@@ -39,7 +39,7 @@ fn shader_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// `glsl/lighting/lighting.comp` becomes `LIGHTING_LIGHTING_COMP`.
+/// `glsl/passes/lighting/lighting.comp` becomes `PASSES_LIGHTING_LIGHTING_COMP`.
 fn const_name(relative: &Path) -> String {
     relative
         .to_string_lossy()

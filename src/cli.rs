@@ -5,11 +5,11 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use crate::gi::{check_voxels, ConeSettings, VoxelStructure, DEFAULT_VOXELS};
-use crate::renderer::{DebugView, GiSettings, RenderSettings, Terms, Tonemap};
+use crate::gi::vct::cli::VctArgs;
+use crate::gi::{DebugView, GiSettings};
+use crate::passes::shadow::ShadowResolution;
 use crate::scene::{GiOverrides, LoadOptions};
-use crate::shadow::ShadowResolution;
-use crate::svo::check_depth;
+use crate::settings::{RenderSettings, Terms, Tonemap};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -34,7 +34,7 @@ pub enum Command {
     Compare(CompareArgs),
 }
 
-/// Which global-illumination method runs.
+/// Which global-illumination technique runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum GiMode {
     /// Direct light only.
@@ -43,8 +43,9 @@ pub enum GiMode {
     #[default]
     Dense,
     /// Voxel cone tracing on a sparse voxel octree built on the GPU, with bricks in 3D
-    /// textures.
-    Svo,
+    /// textures (also accepted as `svo`).
+    #[value(alias = "svo")]
+    Octree,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -52,7 +53,7 @@ pub struct CommonArgs {
     /// Scene: a .toml scene file, a reference .scene.json, or a bare .obj
     /// (default: the built-in Cornell box).
     pub scene: Option<PathBuf>,
-    /// Global illumination method.
+    /// Global-illumination technique.
     #[arg(long, value_enum, default_value_t = GiMode::Dense)]
     pub gi: GiMode,
     /// Enable the Vulkan validation layer (with synchronization validation); any message
@@ -85,70 +86,9 @@ pub struct CommonArgs {
     /// scene.
     #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub sun_shadow_res: u32,
-    /// Voxels per axis of the dense grid, a power of two from 4 to 1024 [default: 64,
-    /// or the scene file's [gi] voxels].
-    #[arg(long)]
-    pub voxels: Option<u32>,
-    /// Levels of the sparse voxel octree (--gi svo), 6 to 10: an effective grid of
-    /// 2^depth voxels per axis [default: log2 of --voxels, so the dense default's 64³].
-    #[arg(long)]
-    pub octree_depth: Option<u32>,
-    /// Full aperture of each diffuse cone, degrees, 1 to 179 [default: 60].
-    #[arg(long)]
-    pub diffuse_aperture: Option<f32>,
-    /// Step of the cones gathering light for the pixels (diffuse, specular, refraction)
-    /// as a fraction of the cone's diameter (beta), 0.05 to 2 [default: 0.25].
-    #[arg(long)]
-    pub step_factor: Option<f32>,
-    /// Step of the voxel bounce's diffuse cones as a fraction of the cone's diameter,
-    /// 0.05 to 2 [default: 0.5].
-    #[arg(long)]
-    pub bounce_step_factor: Option<f32>,
-    /// Step of the soft-shadow cones as a fraction of the cone's diameter, 0.05 to 2
-    /// [default: 0.5].
-    #[arg(long)]
-    pub shadow_step_factor: Option<f32>,
-    /// Step the diffuse cones level by level, each sample twice as far and wide as the
-    /// last (Dřínovský's sampling of wide cones), instead of by the step factor.
-    #[arg(long)]
-    pub wide_steps_by_level: bool,
-    /// Diffuse cones per gather, 1 to 16: one along the normal, the rest in a ring at 57.5
-    /// degrees, each traced on screen as narrower sub-cones [default: 6].
-    #[arg(long)]
-    pub diffuse_cones: Option<u32>,
-    /// Trace the cones (indirect light, soft shadows, specular, refraction) on one pixel of
-    /// each NxN block and upsample, 1 to 8
-    /// [default: height / 64, 2 to 8: 4 at 256 rows, 8 at 512 and above].
-    #[arg(long)]
-    pub indirect_scale: Option<u32>,
-    /// Recompute every bounce every frame, instead of adding one bounce per frame to the
-    /// last frame's light (the first frame always computes them all).
-    #[arg(long)]
-    pub no_accumulate: bool,
-    /// Light bounces between voxels, 1 to 8 (1: direct light on the voxels only)
-    /// [default: 8].
-    #[arg(long)]
-    pub bounces: Option<u32>,
-    /// Shadow the direct light with soft-shadow cones through the voxels instead of with
-    /// shadow maps (needs --gi dense).
-    #[arg(long)]
-    pub shadow_cones: bool,
-    /// Full aperture of the soft-shadow cones, degrees, 0.1 to 90: the apparent size of
-    /// the lights [default: 4].
-    #[arg(long)]
-    pub shadow_aperture: Option<f32>,
-    /// Ambient occlusion: occluders this many voxels away occlude half as much, 0.1 to
-    /// 1024 [default: 4].
-    #[arg(long)]
-    pub ao_distance: Option<f32>,
-    /// Re-voxelize and re-shade the static geometry every frame too (for benchmarks);
-    /// by default static geometry is voxelized once and only moving meshes every frame.
-    #[arg(long)]
-    pub full_update: bool,
-
-    /// How the scene is voxelized (both cover the same voxels)
-    #[arg(long, value_enum, default_value_t)]
-    pub voxelizer: crate::gi::voxelize::Voxelizer,
+    /// The cone tracer's options (--gi dense, --gi octree).
+    #[command(flatten)]
+    pub vct: VctArgs,
     /// Leave out the direct light.
     #[arg(long)]
     pub no_direct: bool,
@@ -168,7 +108,7 @@ pub struct CommonArgs {
     /// light is already occluded, so this darkens twice and is off by default).
     #[arg(long)]
     pub ao: bool,
-    /// Show a debug view instead of the image (needs --gi dense).
+    /// Show a debug view instead of the image (needs --gi dense or --gi octree).
     #[arg(long, value_enum, default_value_t = DebugView::None)]
     pub debug_view: DebugView,
     /// Mip level of the voxel debug views (0: the voxels themselves).
@@ -309,80 +249,26 @@ impl CommonArgs {
     /// defaults.
     pub fn render_settings(&self, scene: &GiOverrides) -> Result<RenderSettings> {
         let options = self.load_options();
-        let d = ConeSettings::default();
-        let cones = ConeSettings {
-            bounces: self.bounces.or(scene.bounces).unwrap_or(d.bounces),
-            indirect_scale: self.indirect_scale.or(scene.indirect_scale),
-            diffuse_cones: self
-                .diffuse_cones
-                .or(scene.diffuse_cones)
-                .unwrap_or(d.diffuse_cones),
-            diffuse_aperture_deg: self
-                .diffuse_aperture
-                .or(scene.diffuse_aperture_deg)
-                .unwrap_or(d.diffuse_aperture_deg),
-            step_factor: self
-                .step_factor
-                .or(scene.step_factor)
-                .unwrap_or(d.step_factor),
-            bounce_step_factor: self
-                .bounce_step_factor
-                .or(scene.bounce_step_factor)
-                .unwrap_or(d.bounce_step_factor),
-            shadow_step_factor: self
-                .shadow_step_factor
-                .or(scene.shadow_step_factor)
-                .unwrap_or(d.shadow_step_factor),
-            wide_steps_by_level: self.wide_steps_by_level
-                || scene.wide_steps_by_level.unwrap_or(d.wide_steps_by_level),
-            accumulate_bounces: !self.no_accumulate,
-            shadow_aperture_deg: self
-                .shadow_aperture
-                .or(scene.shadow_aperture_deg)
-                .unwrap_or(d.shadow_aperture_deg),
-            ao_distance_voxels: self
-                .ao_distance
-                .or(scene.ao_distance_voxels)
-                .unwrap_or(d.ao_distance_voxels),
-        };
-        let voxels = self.voxels.or(scene.voxels).unwrap_or(DEFAULT_VOXELS);
-        let shadow_cones = self.shadow_cones || scene.shadow_cones.unwrap_or(false);
-        if self.octree_depth.is_some() && self.gi != GiMode::Svo {
-            bail!("--octree-depth sets the sparse voxel octree: it needs --gi svo");
+        if self.vct.octree_depth.is_some() && self.gi != GiMode::Octree {
+            bail!("--octree-depth sets the sparse voxel octree: it needs --gi octree");
         }
         let gi = match self.gi {
-            GiMode::Dense | GiMode::Svo => {
-                cones.check()?;
-                if self.gi == GiMode::Dense && self.debug_view == DebugView::OctreeNodes {
-                    bail!("--debug-view octree-nodes shows the octree: it needs --gi svo");
+            GiMode::Dense | GiMode::Octree => {
+                let octree = self.gi == GiMode::Octree;
+                if !octree && self.debug_view == DebugView::OctreeNodes {
+                    bail!("--debug-view octree-nodes shows the octree: it needs --gi octree");
                 }
-                let (voxels, structure) = if self.gi == GiMode::Svo {
-                    let depth = self.octree_depth.unwrap_or(voxels.trailing_zeros());
-                    check_depth(depth)?;
-                    (1 << depth, VoxelStructure::Octree { capacities: None })
-                } else {
-                    (voxels, VoxelStructure::Dense)
-                };
-                check_voxels(voxels)?;
-                Some(GiSettings {
-                    voxels,
-                    structure,
-                    cones,
-                    shadow_cones,
-                    full_update: self.full_update,
-                    voxelizer: self.voxelizer,
-                })
+                GiSettings::ConeTracing(self.vct.settings(octree, scene)?)
             }
             GiMode::Off => {
-                let needs_gi = [
-                    (self.shadow_cones, "--shadow-cones"),
-                    (self.full_update, "--full-update"),
-                    (self.debug_view != DebugView::None, "--debug-view"),
-                ];
-                if let Some((_, option)) = needs_gi.iter().find(|(set, _)| *set) {
-                    bail!("{option} works on the voxels: it needs --gi dense or --gi svo");
+                let mut needs_gi = self.vct.given();
+                if self.debug_view != DebugView::None {
+                    needs_gi.push("--debug-view");
                 }
-                None
+                if let Some(option) = needs_gi.first() {
+                    bail!("{option} works on the voxels: it needs --gi dense or --gi octree");
+                }
+                GiSettings::Off
             }
         };
         Ok(RenderSettings {
@@ -458,6 +344,14 @@ fn write_builtin_scene(dir: &std::path::Path) -> std::io::Result<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gi::vct::{ConeSettings, VctSettings};
+
+    fn cone_tracing(settings: RenderSettings) -> VctSettings {
+        match settings.gi {
+            GiSettings::ConeTracing(vct) => vct,
+            GiSettings::Off => panic!("no cone tracing"),
+        }
+    }
 
     /// A binary away from its checkout loads the copy of the built-in scene it carries.
     #[test]
@@ -505,20 +399,18 @@ mod tests {
             Some(Command::Render(r)) => r.common.render_settings(&scene).unwrap(),
             _ => unreachable!(),
         };
-        let gi = parse(&["voxcone", "render"]).gi.unwrap();
+        let gi = cone_tracing(parse(&["voxcone", "render"]));
         assert_eq!((gi.voxels, gi.cones.diffuse_cones), (32, 9));
         assert!(gi.shadow_cones);
         assert_eq!(gi.cones.step_factor, ConeSettings::default().step_factor);
-        let gi = parse(&[
+        let gi = cone_tracing(parse(&[
             "voxcone",
             "render",
             "--voxels",
             "16",
             "--diffuse-cones",
             "4",
-        ])
-        .gi
-        .unwrap();
+        ]));
         assert_eq!((gi.voxels, gi.cones.diffuse_cones), (16, 4));
     }
 
@@ -532,10 +424,8 @@ mod tests {
             Some(Command::Render(r)) => r.common.render_settings(&scene),
             _ => unreachable!(),
         };
-        let gi = parse(&["voxcone", "render", "--shadow-step-factor", "0.3"])
-            .unwrap()
-            .gi
-            .unwrap();
+        let gi =
+            cone_tracing(parse(&["voxcone", "render", "--shadow-step-factor", "0.3"]).unwrap());
         let d = ConeSettings::default();
         assert_eq!(
             (

@@ -4,7 +4,8 @@ gpu_layout! {
         SET_FRAME = 0;
         /// Descriptor set: the scene's materials and textures.
         SET_SCENE = 1;
-        /// Descriptor set: inputs and outputs of one pass.
+        /// Descriptor set: inputs and outputs of one pass (lighting, composite, the dense
+        /// filter's levels).
         SET_PASS = 2;
 
         /// set 0: `FrameUniforms` uniform buffer.
@@ -43,155 +44,170 @@ gpu_layout! {
         /// composite pass (set 2): HDR radiance in, `sampler2D`.
         BINDING_COMPOSITE_HDR = 0;
 
-        /// GI passes (set 2): `GiUniforms` uniform buffer.
-        BINDING_GI_UNIFORMS = 0;
-        /// GI passes (set 2): voxel albedo, RGBA8 moving average packed in `r32ui` (the octree: its leaf attribute bricks, here and in the next two).
-        BINDING_GI_ALBEDO = 1;
-        /// GI passes (set 2): voxel normal (xyz * 0.5 + 0.5), RGBA8 moving average in `r32ui`.
-        BINDING_GI_NORMAL = 2;
-        /// GI passes (set 2): voxel emission / `GiUniforms.emission_range`, RGBA8 in `r32ui`.
-        BINDING_GI_EMISSION = 3;
-        /// GI passes (set 2): voxel radiance, premultiplied by opacity, `rgba16f` storage (the octree: its leaf radiance bricks).
-        BINDING_GI_RADIANCE = 4;
-        /// GI passes (set 2): voxel radiance, `sampler3D`.
-        BINDING_GI_RADIANCE_SAMPLED = 5;
-        /// GI passes (set 2): the six directional mip volumes side by side along x
-        /// (+X -X +Y -Y +Z -Z), `sampler3D` (the octree: its interior bricks, likewise).
-        BINDING_GI_DIRECTIONAL = 6;
-        /// GI passes (set 2): screen radiance, read and added to, `rgba32f` storage.
-        BINDING_GI_SCREEN = 7;
-        /// GI passes (set 2): G-buffer albedo, `rgba16f` storage.
-        BINDING_GI_GBUFFER_ALBEDO = 8;
-        /// GI passes (set 2): G-buffer normal, `rgba16f` storage.
-        BINDING_GI_GBUFFER_NORMAL = 9;
-        /// GI passes (set 2): G-buffer depth, `sampler2D`.
-        BINDING_GI_GBUFFER_DEPTH = 10;
-        /// GI passes (set 2): voxel direct radiance (before bounces), `rgba16f` storage.
-        BINDING_GI_DIRECT = 11;
-        /// GI passes (set 2): gathered indirect radiance (rgb) and ambient occlusion (a) at reduced resolution, `rgba16f` storage.
-        BINDING_GI_INDIRECT = 12;
-        /// GI passes (set 2): G-buffer transmittance (r) and index of refraction (g), `rg16f` storage.
-        BINDING_GI_GBUFFER_TRANSMISSION = 13;
-        /// GI passes (set 2): soft-shadow cone visibility of every light at reduced
-        /// resolution, `rgba16f` storage: lights 4k..4k+3 in the channels of the k-th band
-        /// of rows, each band as tall as the reduced-resolution image.
-        BINDING_GI_SHADOW = 14;
-        /// GI passes (set 2): specular cone radiance (rgb) at reduced resolution, `rgba16f` storage.
-        BINDING_GI_SPECULAR = 15;
-        /// GI passes (set 2): the occupied voxels, `VoxelList` storage buffer (also the
+        /// Descriptor set of the GI passes that work on the screen: the screen contract every
+        /// technique writes and the upsample reads (`gi::screen`).
+        SET_SCREEN = 2;
+        /// Descriptor set of a GI technique's own resources (the voxel cone tracer's: the
+        /// shared bindings `BINDING_VCT_*`, then its voxel store's).
+        SET_GI = 3;
+
+        /// Screen contract (set 2): `ScreenUniforms` uniform buffer.
+        BINDING_SCREEN_UNIFORMS = 0;
+        /// Screen contract (set 2): screen radiance, written by the lighting pass (or not, when
+        /// the technique shades the direct light), read and added to by the upsample, `rgba32f` storage.
+        BINDING_SCREEN_RADIANCE = 1;
+        /// Screen contract (set 2): G-buffer albedo (rgb) and specular (a), `rgba16f` storage.
+        BINDING_SCREEN_ALBEDO = 2;
+        /// Screen contract (set 2): G-buffer normal and roughness, `rgba16f` storage.
+        BINDING_SCREEN_NORMAL = 3;
+        /// Screen contract (set 2): G-buffer depth, `sampler2D`.
+        BINDING_SCREEN_DEPTH = 4;
+        /// Screen contract (set 2): G-buffer transmittance (r) and index of refraction (g), `rg16f` storage.
+        BINDING_SCREEN_TRANSMISSION = 5;
+        /// Screen contract (set 2): G-buffer emission, `rgba16f` storage (the upsample shades the
+        /// pixels itself when the technique shades the direct light, and the lighting pass does not run).
+        BINDING_SCREEN_EMISSION = 6;
+        /// Screen contract (set 2): gathered indirect radiance (rgb) and ambient occlusion (a) at
+        /// reduced resolution, `rgba16f` storage.
+        BINDING_SCREEN_INDIRECT = 7;
+        /// Screen contract (set 2): the visibility of every light at reduced resolution, when the
+        /// technique shades the direct light, `rgba16f` storage: lights 4k..4k+3 in the channels of
+        /// the k-th band of rows, each band as tall as the reduced-resolution image.
+        BINDING_SCREEN_SHADOW = 8;
+        /// Screen contract (set 2): specular radiance (rgb, before Ks) at reduced resolution, `rgba16f` storage.
+        BINDING_SCREEN_SPECULAR = 9;
+        /// Screen contract (set 2): radiance refracted through transmissive surfaces (rgb) at reduced
+        /// resolution, and 1 in alpha where the sampled pixel is transmissive (0 elsewhere), `rgba16f` storage.
+        BINDING_SCREEN_TRANSMITTED = 10;
+
+        /// Voxel cone tracing (set 3): `VctUniforms` uniform buffer.
+        BINDING_VCT_UNIFORMS = 0;
+        /// Voxel cone tracing (set 3): voxel albedo, RGBA8 mean packed in `r32ui` (the dense grid's
+        /// volume; the octree's leaf attribute bricks, here and in the next two).
+        BINDING_VCT_ALBEDO = 1;
+        /// Voxel cone tracing (set 3): voxel normal (xyz * 0.5 + 0.5), RGBA8 mean in `r32ui`.
+        BINDING_VCT_NORMAL = 2;
+        /// Voxel cone tracing (set 3): voxel emission / `VctUniforms.emission_range`, RGBA8 in `r32ui`.
+        BINDING_VCT_EMISSION = 3;
+        /// Voxel cone tracing (set 3): voxel radiance, premultiplied by opacity, `rgba16f` storage
+        /// (the octree: its leaf radiance bricks).
+        BINDING_VCT_RADIANCE = 4;
+        /// Voxel cone tracing (set 3): the same voxel radiance, `sampler3D`.
+        BINDING_VCT_RADIANCE_SAMPLED = 5;
+        /// Voxel cone tracing (set 3): the directional radiance, `sampler3D`: the dense grid's six
+        /// mip volumes side by side along x (+X -X +Y -Y +Z -Z); the octree's interior bricks, likewise.
+        BINDING_VCT_DIRECTIONAL = 6;
+        /// Voxel cone tracing (set 3): voxel direct radiance (before bounces), `rgba16f` storage.
+        BINDING_VCT_DIRECT = 7;
+        /// Voxel cone tracing (set 3): the occupied voxels, `VoxelList` storage buffer (also the
         /// indirect dispatch arguments of the passes that run over them).
-        BINDING_GI_VOXEL_LIST = 16;
+        BINDING_VCT_VOXEL_LIST = 8;
         /// Workgroup size of the passes that run over the voxel list.
         VOXEL_LIST_GROUP_SIZE = 64;
-        /// GI passes (set 2): G-buffer emission, `rgba16f` storage (the upsample shades the
-        /// pixels itself with soft-shadow cones, and the lighting pass does not run).
-        BINDING_GI_GBUFFER_EMISSION = 17;
-        /// GI passes (set 2): refraction cone radiance (rgb) at reduced resolution, and 1 in
-        /// alpha where the traced pixel is transmissive (0 elsewhere), `rgba16f` storage.
-        BINDING_GI_TRANSMITTED = 18;
-        /// Dense voxelization (set 2): per voxel, the sums of its fragments' albedo, normal and
-        /// emission (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` texels of an `r32ui`
-        /// storage image of 2n x n x 5n texels (`glsl/gi/sums.glsl`), from which the compact
-        /// pass takes the means. Atomic adds are exact and commutative, so the means do not
-        /// depend on the order in which fragments arrive.
-        BINDING_GI_SUMS = 19;
-        /// Dense voxelization (set 2): the static meshes' fragment sums, laid out as
-        /// `BINDING_GI_SUMS` (read when `GiUniforms.static_sums` is 1).
-        BINDING_GI_STATIC_SUMS = 33;
-        /// Compute voxelization (set 2): the scene's vertices (`scene::Vertex`: position, normal, uv), `float[]` storage buffer.
-        BINDING_GI_VERTICES = 34;
-        /// Compute voxelization (set 2): the scene's indices, `uint[]` storage buffer.
-        BINDING_GI_INDICES = 35;
+        /// Compute voxelization (set 3): the scene's vertices (`scene::Vertex`: position, normal, uv), `float[]` storage buffer.
+        BINDING_VCT_VERTICES = 9;
+        /// Compute voxelization (set 3): the scene's indices, `uint[]` storage buffer.
+        BINDING_VCT_INDICES = 10;
         /// Workgroup size of the compute voxelization: the lanes that walk one triangle's pixels.
         VOXELIZE_GROUP_SIZE = 32;
-        /// filter pass (set 2): the base radiance, read by the first level, `rgba16f` storage.
+
+        /// Dense grid (set 3, after the shared bindings): per voxel, the sums of its fragments'
+        /// albedo, normal and emission (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` texels
+        /// of an `r32ui` storage image of 2n x n x 5n texels (`glsl/gi/vct/sums.glsl`), from which the
+        /// compact pass takes the means. Atomic adds are exact and commutative, so the means do not
+        /// depend on the order in which fragments arrive.
+        BINDING_DENSE_SUMS = 11;
+        /// Dense grid (set 3): the static meshes' fragment sums, laid out as `BINDING_DENSE_SUMS`
+        /// (read when `VctUniforms.static_sums` is 1).
+        BINDING_DENSE_STATIC_SUMS = 12;
+        /// Dense filter pass (its own set 2, one per level): the base radiance, read by the first level, `rgba16f` storage.
         BINDING_FILTER_BASE = 0;
-        /// filter pass (set 2): the directional level read (levels after the first), `rgba16f` storage.
+        /// Dense filter pass (its own set 2, one per level): the directional level read (levels after the first), `rgba16f` storage.
         BINDING_FILTER_SRC = 1;
-        /// filter pass (set 2): the directional level written, `rgba16f` storage.
+        /// Dense filter pass (its own set 2, one per level): the directional level written, `rgba16f` storage.
         BINDING_FILTER_DST = 2;
-        /// filter pass (set 2): the voxel normals, oriented to the lit side by injection.
+        /// Dense filter pass (its own set 2, one per level): the voxel normals, oriented to the lit side by injection.
         BINDING_FILTER_NORMAL = 3;
         /// Workgroup edge of the 3D compute passes.
         VOXEL_GROUP_SIZE = 4;
 
-        /// SVO passes (set 2, beside the GI bindings, which hold the octree's pools where
-        /// the dense grid holds volumes): `SvoCounters` then `SvoLevel[SVO_MAX_LEVELS]`,
+        /// Octree (set 3, after the shared bindings, in which the octree binds its pools where the
+        /// dense grid binds volumes): `OctreeCounters` then `OctreeLevel[OCTREE_MAX_LEVELS]`,
         /// storage buffer.
-        BINDING_SVO_COUNTERS = 20;
-        /// SVO passes (set 2): the voxel-fragment list, first half: the fragments' voxels (x | y << 10 | z << 20), then their RGBA8 albedos (from `SvoCounters.fragment_capacity` on; the octree's passes read only the voxels), `uint[]` storage buffer. (Two halves of 8 bytes, so that each fits the 128 MiB that lavapipe binds at depth 9.)
-        BINDING_SVO_FRAGMENTS = 21;
-        /// SVO passes (set 2): the voxel-fragment list, second half: per fragment its RGBA8 normal (xyz * 0.5 + 0.5) and emission / `GiUniforms.emission_range`, `uvec2[]` storage buffer.
-        BINDING_SVO_FRAGMENT_SHADING = 28;
-        /// SVO passes (set 2): per node, its first child (children come in tiles of 8; 0 = none) with `SVO_SUBDIVIDE` set while flagged; for a leaf, which of its 8 voxels hold fragments (bits 0-7, voxel x | y << 1 | z << 2) and the first of their sums (bits 8-31; a leaf is flagged in its coordinates instead, `SVO_LEAF_FLAGGED`), `uint[]` storage buffer.
-        BINDING_SVO_NODES = 22;
-        /// SVO passes (set 2): per node, its coordinates among its level's nodes (x | y << 10 | z << 20), `uint[]` storage buffer.
-        BINDING_SVO_NODE_COORDS = 23;
-        /// SVO passes (set 2): per node, its brick (`SVO_NO_BRICK` for an empty node), in the leaf pools for leaves, in the interior pool otherwise, `uint[]` storage buffer.
-        BINDING_SVO_NODE_BRICKS = 24;
-        /// SVO passes (set 2): per node, its six neighbours at its level (+X -X +Y -Y +Z -Z; `SVO_NO_NODE` where none), `uint[]` storage buffer.
-        BINDING_SVO_NEIGHBOURS = 25;
-        /// SVO passes (set 2): the interior bricks' six directional radiances, `rgba16f` storage (sampled at `BINDING_GI_DIRECTIONAL`).
-        BINDING_SVO_DIRECTIONAL_STORAGE = 26;
-        /// SVO passes (set 2): per occupied leaf voxel, the sums of its fragments' albedo, normal and emission (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` words of a `uint[]` storage buffer: atomic adds are exact and commutative, so the averages do not depend on the order the fragments were listed in.
-        BINDING_SVO_SUMS = 27;
+        BINDING_OCTREE_COUNTERS = 11;
+        /// Octree (set 3): the voxel-fragment list, first half: the fragments' voxels (x | y << 10 | z << 20), then their RGBA8 albedos (from `OctreeCounters.fragment_capacity` on; the octree's passes read only the voxels), `uint[]` storage buffer. (Two halves of 8 bytes, so that each fits the 128 MiB that lavapipe binds at depth 9.)
+        BINDING_OCTREE_FRAGMENTS = 12;
+        /// Octree (set 3): the voxel-fragment list, second half: per fragment its RGBA8 normal (xyz * 0.5 + 0.5) and emission / `VctUniforms.emission_range`, `uvec2[]` storage buffer.
+        BINDING_OCTREE_FRAGMENT_SHADING = 13;
+        /// Octree (set 3): per node, its first child (children come in tiles of 8; 0 = none) with `OCTREE_SUBDIVIDE` set while flagged; for a leaf, which of its 8 voxels hold fragments (bits 0-7, voxel x | y << 1 | z << 2) and the first of their sums (bits 8-31; a leaf is flagged in its coordinates instead, `OCTREE_LEAF_FLAGGED`), `uint[]` storage buffer.
+        BINDING_OCTREE_NODES = 14;
+        /// Octree (set 3): per node, its coordinates among its level's nodes (x | y << 10 | z << 20), `uint[]` storage buffer.
+        BINDING_OCTREE_NODE_COORDS = 15;
+        /// Octree (set 3): per node, its brick (`OCTREE_NO_BRICK` for an empty node), in the leaf pools for leaves, in the interior pool otherwise, `uint[]` storage buffer.
+        BINDING_OCTREE_NODE_BRICKS = 16;
+        /// Octree (set 3): per node, its six neighbours at its level (+X -X +Y -Y +Z -Z; `OCTREE_NO_NODE` where none), `uint[]` storage buffer.
+        BINDING_OCTREE_NEIGHBOURS = 17;
+        /// Octree (set 3): the interior bricks' six directional radiances, `rgba16f` storage (sampled at `BINDING_VCT_DIRECTIONAL`).
+        BINDING_OCTREE_DIRECTIONAL_STORAGE = 18;
+        /// Octree (set 3): per occupied leaf voxel, the sums of its fragments' albedo, normal and emission (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` words of a `uint[]` storage buffer: atomic adds are exact and commutative, so the averages do not depend on the order the fragments were listed in.
+        BINDING_OCTREE_SUMS = 19;
+        /// Octree (set 3): the light each leaf voxel in a new brick gathered in the last frame, for the same voxel in the next frame's octree rebuilt around moving meshes (which gives it a new brick again): two hash tables of `carry_capacity` entries (key = voxel x | y << 10 | z << 20, plus 1; then the RGB floats), `uint[]` storage buffer.
+        BINDING_OCTREE_CARRY = 20;
+        /// Octree (set 3): the static part's child entries as the static build left them (Dřínovský 2013, 5.7): each frame restores them, and a static leaf that a moving mesh's fragments reach reads its own voxels' mask and sums from here, `uint[]` storage buffer.
+        BINDING_OCTREE_STATIC_NODES = 21;
+        /// Octree (set 3): per brick (the leaf bricks', then the interior bricks'), `OCTREE_CHANGED` and `OCTREE_BORDER` bits while the filter's update lists are built, `uint[]` storage buffer.
+        BINDING_OCTREE_CHANGES = 22;
+        /// Octree (set 3): the filter's update lists (Dřínovský 2013, 5.5): `OctreeUpdateList[OCTREE_UPDATE_LISTS]`, `OctreeBounceDispatch`, then each list's nodes (`OctreeCounters.update_capacity` each), `uint[]` storage buffer.
+        BINDING_OCTREE_UPDATES = 23;
+        /// Octree (set 3): the node grid, a dense index into the octree at level `depth - 1 - OCTREE_NODE_GRID_ABOVE_LEAVES` (`glsl/gi/vct/octree/nodes/grid.comp`): per cell, its node there, or `OCTREE_GRID_GAP` plus the level of the childless node above where its cube is empty; cone samples start their descent from it, `uint[]` storage buffer.
+        BINDING_OCTREE_NODE_GRID = 24;
         /// Words of a voxel's fragment sums (dense grid and octree alike): albedo RGB, normal
-        /// XYZ, emission RGB, then the fragment count (`glsl/gi/sums.glsl`).
+        /// XYZ, emission RGB, then the fragment count (`glsl/gi/vct/sums.glsl`).
         VOXEL_SUM_WORDS = 10;
-        /// SVO passes (set 2): the light each leaf voxel in a new brick gathered in the last frame, for the same voxel in the next frame's octree rebuilt around moving meshes (which gives it a new brick again): two hash tables of `carry_capacity` entries (key = voxel x | y << 10 | z << 20, plus 1; then the RGB floats), `uint[]` storage buffer.
-        BINDING_SVO_CARRY = 29;
-        /// SVO passes (set 2): the static part's child entries as the static build left them (Dřínovský 2013, 5.7): each frame restores them, and a static leaf that a moving mesh's fragments reach reads its own voxels' mask and sums from here, `uint[]` storage buffer.
-        BINDING_SVO_STATIC_NODES = 30;
-        /// SVO passes (set 2): per brick (the leaf bricks', then the interior bricks'), `SVO_CHANGED` and `SVO_BORDER` bits while the filter's update lists are built, `uint[]` storage buffer.
-        BINDING_SVO_CHANGES = 31;
-        /// SVO passes (set 2): the filter's update lists (Dřínovský 2013, 5.5): `SvoUpdateList[SVO_UPDATE_LISTS]`, `SvoBounceDispatch`, then each list's nodes (`SvoCounters.update_capacity` each), `uint[]` storage buffer.
-        BINDING_SVO_UPDATES = 32;
-        /// SVO passes (set 2): the node grid, a dense index into the octree at level `depth - 1 - SVO_NODE_GRID_ABOVE_LEAVES` (`glsl/svo/octree/grid.comp`): per cell, its node there, or `SVO_GRID_GAP` plus the level of the childless node above where its cube is empty; cone samples start their descent from it, `uint[]` storage buffer.
-        BINDING_SVO_NODE_GRID = 36;
         /// Levels between the node grid and the leaves: samples of the finest levels descend at most this far from the grid (from the root, 7 more at depth 10).
-        SVO_NODE_GRID_ABOVE_LEAVES = 3;
-        /// A node grid entry at or above this is no node: the cell is empty from level (entry - `SVO_GRID_GAP`) down.
-        SVO_GRID_GAP = 0xFFFFFF00;
+        OCTREE_NODE_GRID_ABOVE_LEAVES = 3;
+        /// A node grid entry at or above this is no node: the cell is empty from level (entry - `OCTREE_GRID_GAP`) down.
+        OCTREE_GRID_GAP = 0xFFFFFF00;
         /// Update lists: nodes whose radiance changed, at levels of even and odd parity (0, 1), and nodes whose border must be copied again (2, 3).
-        SVO_UPDATE_LISTS = 4;
+        OCTREE_UPDATE_LISTS = 4;
         /// Bit of a brick's change word: its voxels' radiance changed (it is in a changed list).
-        SVO_CHANGED = 1;
+        OCTREE_CHANGED = 1;
         /// Bit of a brick's change word: a voxel of it or of a neighbour changed (it is in a border list).
-        SVO_BORDER = 2;
-        /// `SvoPush.over`: every node of the level.
-        SVO_OVER_LEVEL = 0;
-        /// `SvoPush.over`: the level's appended nodes only.
-        SVO_OVER_APPENDED = 1;
-        /// `SvoPush.over`: the nodes of update list `SvoPush.list`.
-        SVO_OVER_LIST = 2;
+        OCTREE_BORDER = 2;
+        /// `OctreePush.over`: every node of the level.
+        OCTREE_OVER_LEVEL = 0;
+        /// `OctreePush.over`: the level's appended nodes only.
+        OCTREE_OVER_APPENDED = 1;
+        /// `OctreePush.over`: the nodes of update list `OctreePush.list`.
+        OCTREE_OVER_LIST = 2;
         /// Edge of a leaf attribute brick (albedo, normal, emission, direct light): the leaf's 2x2x2 voxels.
-        SVO_ATTRIBUTE_BRICK = 2;
+        OCTREE_ATTRIBUTE_BRICK = 2;
         /// Edge of a radiance brick: the node's 2x2x2 voxels and a border of one voxel copied from the neighbours, so that trilinear filtering inside the node needs no other brick.
-        SVO_RADIANCE_BRICK = 4;
+        OCTREE_RADIANCE_BRICK = 4;
         /// Octree levels the level table has room for (depth 10 uses 10).
-        SVO_MAX_LEVELS = 16;
+        OCTREE_MAX_LEVELS = 16;
         /// Workgroup size of the passes over fragments and over a level's nodes.
-        SVO_GROUP_SIZE = 64;
+        OCTREE_GROUP_SIZE = 64;
         /// Workgroups along y of a dispatch over an update list: the border transfer, filter and spread passes share each node's work (texels, children, neighbours) among them, so that a short list still fills the GPU (1 on a CPU driver, where a workgroup costs more than the work it shares).
-        SVO_LIST_SLICES = 8;
+        OCTREE_LIST_SLICES = 8;
         /// Bit of a node's child entry: the node is to be subdivided.
-        SVO_SUBDIVIDE = 0x80000000;
+        OCTREE_SUBDIVIDE = 0x80000000;
         /// Bit of a leaf's coordinates (above x | y << 10 | z << 20): fragments of the current insertion reached the leaf; set by the flag pass, cleared by the alloc pass (the leaf's child entry has no bit to spare: its first sum takes bits 8-31, for up to 2^24 leaf voxels).
-        SVO_LEAF_FLAGGED = 0x40000000;
+        OCTREE_LEAF_FLAGGED = 0x40000000;
         /// A missing node (neighbour pointers, look-ups).
-        SVO_NO_NODE = 0xFFFFFFFF;
+        OCTREE_NO_NODE = 0xFFFFFFFF;
         /// A node without a brick (it holds no voxel).
-        SVO_NO_BRICK = 0xFFFFFFFF;
-        /// `SvoCounters.overflow` bit: the voxel-fragment list was too small.
-        SVO_OVERFLOW_FRAGMENTS = 1;
-        /// `SvoCounters.overflow` bit: the node pool was too small.
-        SVO_OVERFLOW_NODES = 2;
-        /// `SvoCounters.overflow` bit: the leaf brick pool was too small.
-        SVO_OVERFLOW_LEAF_BRICKS = 4;
-        /// `SvoCounters.overflow` bit: the interior brick pool was too small.
-        SVO_OVERFLOW_INTERIOR_BRICKS = 8;
-        /// `SvoCounters.overflow` bit: the leaf voxels' sums buffer was too small.
-        SVO_OVERFLOW_LEAF_VOXELS = 16;
+        OCTREE_NO_BRICK = 0xFFFFFFFF;
+        /// `OctreeCounters.overflow` bit: the voxel-fragment list was too small.
+        OCTREE_OVERFLOW_FRAGMENTS = 1;
+        /// `OctreeCounters.overflow` bit: the node pool was too small.
+        OCTREE_OVERFLOW_NODES = 2;
+        /// `OctreeCounters.overflow` bit: the leaf brick pool was too small.
+        OCTREE_OVERFLOW_LEAF_BRICKS = 4;
+        /// `OctreeCounters.overflow` bit: the interior brick pool was too small.
+        OCTREE_OVERFLOW_INTERIOR_BRICKS = 8;
+        /// `OctreeCounters.overflow` bit: the leaf voxels' sums buffer was too small.
+        OCTREE_OVERFLOW_LEAF_VOXELS = 16;
 
         /// `GpuLight.kind`: point light, intensity in W/sr.
         LIGHT_POINT = 0;
@@ -328,8 +344,8 @@ gpu_layout! {
         uint pad,
     }
 
-    /// The dense voxel grid and cone-tracing settings.
-    struct GiUniforms {
+    /// The voxel grid (dense, or the octree's effective grid) and the cone settings.
+    struct VctUniforms {
         /// xyz world position of the grid's minimum corner, w voxel size.
         vec4 origin,
         /// Voxels per axis.
@@ -348,8 +364,6 @@ gpu_layout! {
         float diffuse_tan_half,
         /// Cones stop after this distance in world units.
         float max_distance,
-        /// Indirect light is traced on one pixel of each `indirect_scale`² block.
-        uint indirect_scale,
         /// Cones of the diffuse gather: one along the normal, the rest in a ring at 57.5 degrees.
         uint diffuse_cones,
         /// tan of half the aperture of the soft-shadow cones.
@@ -358,11 +372,25 @@ gpu_layout! {
         float ao_distance,
         /// 1: the diffuse (wide) cones step level by level, each sample twice as wide as the last (Dřínovský 2013, 5.6); 0: by their step factor of their diameter (`step_factor` for the pixels, `bounce_step_factor` in the voxel bounce), as the other cones.
         uint wide_steps_by_level,
-        /// 1: the dense grid's compact pass adds the static meshes' fragment sums (`BINDING_GI_STATIC_SUMS`) to this frame's (a scene with moving meshes, static meshes voxelized once).
+        /// 1: the dense grid's compact pass adds the static meshes' fragment sums (`BINDING_DENSE_STATIC_SUMS`) to this frame's (a scene with moving meshes, static meshes voxelized once).
         uint static_sums,
         /// Pads the struct to a multiple of 16 bytes.
         uint pad0,
         /// Pads the struct to a multiple of 16 bytes.
+        uint pad1,
+        /// Pads the struct to a multiple of 16 bytes.
+        uint pad2,
+    }
+
+    /// What the upsample needs to know of the reduced-resolution terms a technique gathered.
+    struct ScreenUniforms {
+        /// The terms are sampled at one pixel of each `indirect_scale`² block.
+        uint indirect_scale,
+        /// The world distance off a pixel's plane at which a sample's weight falls to 1/e (the technique's spatial resolution: two voxels for the cone tracer).
+        float plane_tolerance,
+        /// Unused.
+        uint pad0,
+        /// Unused.
         uint pad1,
     }
 
@@ -379,8 +407,8 @@ gpu_layout! {
     }
 
     /// The counters of the sparse voxel octree's pools; the level table follows.
-    struct SvoCounters {
-        /// Indirect dispatch over the stored fragments: workgroups of `SVO_GROUP_SIZE`.
+    struct OctreeCounters {
+        /// Indirect dispatch over the stored fragments: workgroups of `OCTREE_GROUP_SIZE`.
         uint fragment_groups_x,
         /// Indirect dispatch: 1.
         uint fragment_groups_y,
@@ -394,7 +422,7 @@ gpu_layout! {
         uint node_count,
         /// Nodes the node pool holds.
         uint node_capacity,
-        /// `SVO_OVERFLOW_*` bits.
+        /// `OCTREE_OVERFLOW_*` bits.
         uint overflow,
         /// Leaf bricks allocated.
         uint leaf_bricks,
@@ -431,8 +459,8 @@ gpu_layout! {
     }
 
     /// One level of the octree: its nodes in two contiguous runs of the node pool, the static part's (built once) and those appended since (a build appends every level but the root; a frame appends the moving meshes' nodes after the static part).
-    struct SvoLevel {
-        /// Indirect dispatch over the level's nodes, both runs: workgroups of `SVO_GROUP_SIZE`.
+    struct OctreeLevel {
+        /// Indirect dispatch over the level's nodes, both runs: workgroups of `OCTREE_GROUP_SIZE`.
         uint groups_x,
         /// Indirect dispatch: 1.
         uint groups_y,
@@ -458,11 +486,11 @@ gpu_layout! {
         uint pad1,
     }
 
-    /// One update list's head: its nodes follow in `BINDING_SVO_UPDATES`.
-    struct SvoUpdateList {
-        /// Indirect dispatch over the list: workgroups of `SVO_GROUP_SIZE`.
+    /// One update list's head: its nodes follow in `BINDING_OCTREE_UPDATES`.
+    struct OctreeUpdateList {
+        /// Indirect dispatch over the list: workgroups of `OCTREE_GROUP_SIZE`.
         uint groups_x,
-        /// Indirect dispatch: `SVO_LIST_SLICES` (1 on a CPU driver).
+        /// Indirect dispatch: `OCTREE_LIST_SLICES` (1 on a CPU driver).
         uint groups_y,
         /// Indirect dispatch: 1.
         uint groups_z,
@@ -487,7 +515,7 @@ gpu_layout! {
     }
 
     /// The bounce's dispatch in a static octree, after the update lists' heads: the voxel list's while anything changed since the last bounce, none once the bounces have converged.
-    struct SvoBounceDispatch {
+    struct OctreeBounceDispatch {
         /// Indirect dispatch: the voxel list's workgroups, or 0.
         uint groups_x,
         /// Indirect dispatch: 1.
@@ -499,12 +527,12 @@ gpu_layout! {
     }
 
     /// Push constants of the octree passes that work on one level.
-    struct SvoPush {
+    struct OctreePush {
         /// The level.
         uint level,
-        /// Which of the level's nodes: `SVO_OVER_LEVEL`, `SVO_OVER_APPENDED` or `SVO_OVER_LIST`.
+        /// Which of the level's nodes: `OCTREE_OVER_LEVEL`, `OCTREE_OVER_APPENDED` or `OCTREE_OVER_LIST`.
         uint over,
-        /// With `SVO_OVER_LIST`: the update list.
+        /// With `OCTREE_OVER_LIST`: the update list.
         uint list,
         /// Unused.
         uint pad2,
@@ -522,7 +550,7 @@ gpu_layout! {
         uint material,
         /// Index into the shadow view buffer (shadow pass only).
         uint shadow_view,
-        /// The mesh's first index in the index buffer (compute voxelization only: `BINDING_GI_INDICES`).
+        /// The mesh's first index in the index buffer (compute voxelization only: `BINDING_VCT_INDICES`).
         uint first_index,
         /// Added to the mesh's indices (compute voxelization only).
         uint vertex_offset,

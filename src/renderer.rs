@@ -1,176 +1,31 @@
-//! The frame: the passes in the order data flows through them.
+//! The frame: one flat list of passes, in the order data flows through them.
 //!
-//! shadow maps -> G-buffer -> deferred direct lighting -> composite (tonemap to output)
+//! shadow maps -> G-buffer -> GI update -> deferred direct lighting -> GI gather ->
+//! upsample -> composite (tonemap to output)
+//!
+//! The GI passes are a technique's ([`crate::gi::Technique`]); the lighting pass does not
+//! run when the technique shades the direct light itself, and the upsample does not run
+//! when its gather wrote the screen radiance (a debug view).
 
 use std::sync::Arc;
 
 use anyhow::{bail, Result};
 use ash::vk;
-use glam::Vec3;
-use gpu_allocator::MemoryLocation;
 
-use crate::composite::CompositePass;
-use crate::gbuffer::{GBuffer, GBufferPass};
-use crate::gi::{ConeSettings, VoxelGi, VoxelStructure};
-use crate::gpu_layout::{self as layout, FrameUniforms, GpuLight, ShadowView};
-use crate::lighting::LightingPass;
-use crate::scene::{Camera, LightKind, Scene};
+use crate::frame_data::{self, FrameData};
+use crate::gi::{self, DebugView, FrameInputs, GatherOptions, Gathered, Screen, Technique};
+use crate::gpu_layout::{self as layout, FrameUniforms, ShadowView};
+use crate::passes::composite::CompositePass;
+use crate::passes::gbuffer::{GBuffer, GBufferPass};
+use crate::passes::lighting::LightingPass;
+use crate::passes::shadow::{self, ShadowPass};
+use crate::scene::{Camera, Scene};
 use crate::scene_gpu::{GpuScene, SceneDraw};
-use crate::shadow::{self, ShadowPass, ShadowResolution};
+use crate::settings::{RenderSettings, Tonemap};
 use crate::vk::{
-    copies_to_host_barrier, image_barrier, sampler_info, Binding, Buffer, Context, DescriptorSets,
-    Frame, FrameRing, GpuTimer, Image, ImageUse, Sampler, SetWriter,
+    compute_to_compute, copy_image_to_buffer, image_barrier, sampler_info, Buffer, Context,
+    DescriptorSets, Frame, FrameRing, Image, ImageUse, Sampler,
 };
-
-/// How the final image is mapped to the display.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
-pub enum Tonemap {
-    /// clamp(x), then sRGB: the convention of the reference PNGs.
-    #[default]
-    Clamp,
-    /// Filmic curve (Narkowicz's ACES fit), then sRGB.
-    Aces,
-}
-
-/// Global illumination by voxel cone tracing.
-#[derive(Clone, Copy, Debug)]
-pub struct GiSettings {
-    /// Voxels per axis (a power of two): of the dense grid, or effective of the octree.
-    pub voxels: u32,
-    pub structure: VoxelStructure,
-    pub cones: ConeSettings,
-    /// Direct light shadowed by soft-shadow cones through the voxels instead of by the
-    /// shadow maps (which still light the voxels).
-    pub shadow_cones: bool,
-    /// Re-voxelize and re-shade the static geometry every frame too (benchmarks).
-    pub full_update: bool,
-    pub voxelizer: crate::gi::voxelize::Voxelizer,
-}
-
-/// The terms of the final image; each can be switched.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Terms {
-    pub direct: bool,
-    pub emission: bool,
-    pub indirect_diffuse: bool,
-    pub indirect_specular: bool,
-    pub transmission: bool,
-    /// Multiply the indirect light by ambient occlusion. Off by default: the cones that
-    /// gather the indirect light are already occluded by the same voxels, so this darkens
-    /// twice (Cornell box LDR-FLIP 0.226 with it against 0.171 without); it is the classic
-    /// contact-shadow look, not the physically based image.
-    pub ambient_occlusion: bool,
-}
-
-impl Default for Terms {
-    fn default() -> Self {
-        Self {
-            direct: true,
-            emission: true,
-            indirect_diffuse: true,
-            indirect_specular: true,
-            transmission: true,
-            ambient_occlusion: false,
-        }
-    }
-}
-
-/// What the image shows instead of the composited frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
-pub enum DebugView {
-    /// The composited frame.
-    #[default]
-    None,
-    /// Indirect light only (diffuse, specular and transmitted).
-    Indirect,
-    /// Ambient occlusion only.
-    Ao,
-    /// Voxel albedo at mip `--debug-level`.
-    VoxelAlbedo,
-    /// Voxel normals (xyz * 0.5 + 0.5) at mip `--debug-level`.
-    VoxelNormal,
-    /// Voxel radiance at mip `--debug-level`, from the volume facing the camera ray.
-    VoxelRadiance,
-    /// The octree's occupied nodes `--debug-level` levels above the leaves, each in its
-    /// own colour with its edges drawn (`--gi svo` only).
-    OctreeNodes,
-}
-
-impl DebugView {
-    /// Every view, in the viewer's cycling order.
-    pub const ALL: [DebugView; 7] = [
-        DebugView::None,
-        DebugView::Indirect,
-        DebugView::Ao,
-        DebugView::VoxelAlbedo,
-        DebugView::VoxelNormal,
-        DebugView::VoxelRadiance,
-        DebugView::OctreeNodes,
-    ];
-
-    fn code(self) -> u32 {
-        match self {
-            DebugView::None => layout::DEBUG_NONE,
-            DebugView::Indirect => layout::DEBUG_INDIRECT,
-            DebugView::Ao => layout::DEBUG_AO,
-            DebugView::VoxelAlbedo => layout::DEBUG_VOXEL_ALBEDO,
-            DebugView::VoxelNormal => layout::DEBUG_VOXEL_NORMAL,
-            DebugView::VoxelRadiance => layout::DEBUG_VOXEL_RADIANCE,
-            DebugView::OctreeNodes => layout::DEBUG_OCTREE_NODES,
-        }
-    }
-
-    /// Whether the view shows the voxels rather than the screen.
-    pub fn shows_voxels(self) -> bool {
-        matches!(
-            self,
-            DebugView::VoxelAlbedo
-                | DebugView::VoxelNormal
-                | DebugView::VoxelRadiance
-                | DebugView::OctreeNodes
-        )
-    }
-}
-
-/// Settings that change what a frame computes.
-#[derive(Clone, Debug)]
-pub struct RenderSettings {
-    /// Add the specular lobe of MTL Ks.
-    pub specular: bool,
-    /// Use tangent-space normal maps.
-    pub normal_maps: bool,
-    /// Exposure in stops applied before the tonemap (not to EXR output).
-    pub exposure_ev: f32,
-    pub tonemap: Tonemap,
-    /// Texels per side of each light view's shadow map.
-    pub shadow_resolution: ShadowResolution,
-    /// Keep the shadow maps while no light and no mesh moves.
-    pub cache_shadows: bool,
-    /// Indirect light; `None` for direct light only.
-    pub gi: Option<GiSettings>,
-    pub terms: Terms,
-    /// Needs `gi`.
-    pub debug_view: DebugView,
-    /// Mip level of the voxel debug views.
-    pub debug_level: u32,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self {
-            specular: true,
-            normal_maps: true,
-            exposure_ev: 0.0,
-            tonemap: Tonemap::Clamp,
-            shadow_resolution: ShadowResolution::default(),
-            cache_shadows: true,
-            gi: None,
-            terms: Terms::default(),
-            debug_view: DebugView::None,
-            debug_level: 0,
-        }
-    }
-}
 
 /// Where a frame's composite goes.
 #[derive(Clone, Copy, Debug)]
@@ -182,15 +37,6 @@ pub struct OutputTarget {
     pub before: ImageUse,
     /// The state to leave it in.
     pub after: ImageUse,
-}
-
-/// Per-frame-in-flight data written by the host.
-struct FrameData {
-    uniforms: Buffer,
-    lights: Buffer,
-    shadow_views: Buffer,
-    set: vk::DescriptorSet,
-    timer: GpuTimer,
 }
 
 /// Screen-sized images, recreated on resize.
@@ -211,7 +57,8 @@ pub struct Renderer {
     lighting: LightingPass,
     gbuffer_pass: GBufferPass,
     shadow: ShadowPass,
-    gi: Option<VoxelGi>,
+    /// The technique and the screen contract it gathers into (none with `--gi off`).
+    gi: Option<(Box<dyn Technique>, Screen)>,
     /// Whether the GI passes run (the viewer's toggle).
     indirect: bool,
     /// Light views and mesh transforms the shadow maps were last rendered with.
@@ -229,32 +76,6 @@ pub struct Renderer {
 
 const FRAMES_IN_FLIGHT: usize = 2;
 
-fn frame_bindings() -> [Binding; 4] {
-    let all = vk::ShaderStageFlags::ALL;
-    [
-        Binding::new(
-            layout::BINDING_FRAME_UNIFORMS,
-            vk::DescriptorType::UNIFORM_BUFFER,
-            all,
-        ),
-        Binding::new(
-            layout::BINDING_LIGHTS,
-            vk::DescriptorType::STORAGE_BUFFER,
-            all,
-        ),
-        Binding::new(
-            layout::BINDING_SHADOW_VIEWS,
-            vk::DescriptorType::STORAGE_BUFFER,
-            all,
-        ),
-        Binding::new(
-            layout::BINDING_SHADOW_MAP,
-            vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-            all,
-        ),
-    ]
-}
-
 impl Renderer {
     pub fn new(
         ctx: &Arc<Context>,
@@ -263,24 +84,42 @@ impl Renderer {
         extent: vk::Extent2D,
         output_format: vk::Format,
     ) -> Result<Self> {
-        if settings.gi.is_none() && settings.debug_view != DebugView::None {
-            bail!(
-                "the debug view {:?} shows the voxel GI: it needs --gi dense",
-                settings.debug_view
-            );
-        }
         let gpu = GpuScene::new(ctx, &scene)?;
-        let frame_sets =
-            DescriptorSets::new(ctx, "frame", &frame_bindings(), FRAMES_IN_FLIGHT as u32)?;
+        let frame_sets = DescriptorSets::new(
+            ctx,
+            "frame",
+            &frame_data::bindings(),
+            FRAMES_IN_FLIGHT as u32,
+        )?;
         let set_layouts = [frame_sets.layout, gpu.sets.layout];
         let shadow = ShadowPass::new(ctx, &scene, settings.shadow_resolution, &set_layouts)?;
         let gbuffer_pass = GBufferPass::new(ctx, &set_layouts)?;
         let lighting = LightingPass::new(ctx, set_layouts)?;
         let composite = CompositePass::new(ctx, set_layouts, output_format)?;
-        let gi = settings
-            .gi
-            .map(|g| VoxelGi::new(ctx, &scene, &gpu, &g, set_layouts, FRAMES_IN_FLIGHT))
-            .transpose()?;
+        let gi = if matches!(settings.gi, gi::GiSettings::Off) {
+            None
+        } else {
+            let screen = Screen::new(ctx, set_layouts, scene.lights.len() as u32)?;
+            let inputs = gi::Inputs {
+                ctx,
+                scene: &scene,
+                gpu: &gpu,
+                set_layouts: [set_layouts[0], set_layouts[1], screen.layout()],
+                frames_in_flight: FRAMES_IN_FLIGHT,
+            };
+            gi::create(&inputs, &settings.gi)?.map(|technique| (technique, screen))
+        };
+        let debug_views = gi.as_ref().map_or(&[][..], |(t, _)| t.debug_views());
+        let offered = DebugView::SCREEN.contains(&settings.debug_view)
+            || debug_views.contains(&settings.debug_view);
+        if settings.debug_view != DebugView::None && (gi.is_none() || !offered) {
+            bail!(
+                "the debug view {:?} is not one of this technique's ({:?}): it needs \
+                 --gi dense or --gi octree (octree-nodes: --gi octree)",
+                settings.debug_view,
+                debug_views
+            );
+        }
         let nearest_sampler = Sampler::new(
             ctx,
             "nearest",
@@ -295,68 +134,9 @@ impl Renderer {
                 .compare_enable(true)
                 .compare_op(vk::CompareOp::LESS_OR_EQUAL),
         )?;
-        let light_slots = scene.lights.len().max(1);
-        let view_slots: u32 = scene
-            .lights
-            .iter()
-            .map(shadow::view_count)
-            .sum::<u32>()
-            .max(1);
-        let mut frames = Vec::new();
-        for i in 0..FRAMES_IN_FLIGHT {
-            let uniforms = Buffer::new(
-                ctx,
-                &format!("frame uniforms {i}"),
-                std::mem::size_of::<FrameUniforms>() as u64,
-                vk::BufferUsageFlags::UNIFORM_BUFFER,
-                MemoryLocation::CpuToGpu,
-            )?;
-            let lights = Buffer::new(
-                ctx,
-                &format!("lights {i}"),
-                (std::mem::size_of::<GpuLight>() * light_slots) as u64,
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-                MemoryLocation::CpuToGpu,
-            )?;
-            let shadow_views = Buffer::new(
-                ctx,
-                &format!("shadow views {i}"),
-                (std::mem::size_of::<ShadowView>() * view_slots as usize) as u64,
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-                MemoryLocation::CpuToGpu,
-            )?;
-            let set = frame_sets.allocate(&format!("frame {i}"))?;
-            SetWriter::new(ctx, set)
-                .buffer(
-                    layout::BINDING_FRAME_UNIFORMS,
-                    vk::DescriptorType::UNIFORM_BUFFER,
-                    uniforms.raw,
-                )
-                .buffer(
-                    layout::BINDING_LIGHTS,
-                    vk::DescriptorType::STORAGE_BUFFER,
-                    lights.raw,
-                )
-                .buffer(
-                    layout::BINDING_SHADOW_VIEWS,
-                    vk::DescriptorType::STORAGE_BUFFER,
-                    shadow_views.raw,
-                )
-                .sampled_image(
-                    layout::BINDING_SHADOW_MAP,
-                    shadow.map.view,
-                    shadow_sampler.raw,
-                    vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
-                )
-                .apply();
-            frames.push(FrameData {
-                uniforms,
-                lights,
-                shadow_views,
-                set,
-                timer: GpuTimer::new(ctx)?,
-            });
-        }
+        let frames = (0..FRAMES_IN_FLIGHT)
+            .map(|i| FrameData::new(ctx, i, &frame_sets, &scene, &shadow.map, &shadow_sampler))
+            .collect::<Result<_>>()?;
         let targets = Self::create_targets(ctx, extent)?;
         let mut renderer = Self {
             camera: scene.camera.clone(),
@@ -381,14 +161,14 @@ impl Renderer {
             ctx: ctx.clone(),
         };
         renderer.bind_targets()?;
-        if let Some(gi) = &mut renderer.gi {
+        if let Some((technique, _)) = &mut renderer.gi {
             let draw = SceneDraw {
                 scene: &renderer.scene,
                 gpu: &renderer.gpu,
                 frame_set: renderer.frames[0].set,
                 time_s: 0.0,
             };
-            gi.prepare(&draw)?;
+            technique.prepare(&draw)?;
         }
         Ok(renderer)
     }
@@ -412,8 +192,9 @@ impl Renderer {
             .bind_targets(&self.ctx, &t.gbuffer, &t.radiance, self.nearest_sampler.raw);
         self.composite
             .bind_input(&self.ctx, &t.radiance, self.nearest_sampler.raw);
-        if let Some(gi) = &mut self.gi {
-            gi.bind_screen(&t.gbuffer, &t.radiance, self.nearest_sampler.raw)?;
+        if let Some((technique, screen)) = &mut self.gi {
+            let request = technique.screen_request(t.gbuffer.extent());
+            screen.bind(&t.gbuffer, &t.radiance, self.nearest_sampler.raw, request)?;
         }
         Ok(())
     }
@@ -426,41 +207,70 @@ impl Renderer {
         self.targets.gbuffer.extent()
     }
 
-    /// Whether this frame shadows the direct light with soft-shadow cones (GI on, and
-    /// asked for) instead of shadow maps.
-    fn shadow_cones_active(&self) -> bool {
-        self.indirect && self.gi.is_some() && self.settings.gi.is_some_and(|g| g.shadow_cones)
+    /// The technique, while its passes run (the viewer can pause them).
+    fn active_gi(&self) -> Option<&dyn Technique> {
+        self.gi
+            .as_ref()
+            .filter(|_| self.indirect)
+            .map(|(technique, _)| &**technique)
+    }
+
+    /// Whether this frame's technique shades the direct light itself (soft-shadow cones)
+    /// instead of the lighting pass with shadow maps.
+    fn gi_shades_direct(&self) -> bool {
+        self.active_gi().is_some_and(|t| t.shades_direct())
     }
 
     /// Turns the indirect light on or off (when the renderer has GI); returns whether it
     /// is on now.
     pub fn toggle_indirect(&mut self) -> bool {
         match &mut self.gi {
-            Some(gi) => {
+            Some((technique, _)) => {
                 self.indirect = !self.indirect;
-                // Bounces accumulated before the pause may no longer match the scene.
-                gi.restart();
+                // What was accumulated before the pause may no longer match the scene.
+                technique.restart();
                 self.indirect
             }
             None => false,
         }
     }
 
-    /// The voxel GI, when enabled.
-    pub fn gi(&self) -> Option<&VoxelGi> {
-        self.gi.as_ref()
+    /// The GI technique, when there is one.
+    pub fn gi(&self) -> Option<&dyn Technique> {
+        self.gi.as_ref().map(|(technique, _)| &**technique)
     }
 
-    #[cfg(test)]
-    pub fn gi_mut(&mut self) -> Option<&mut VoxelGi> {
-        self.gi.as_mut()
+    /// The GI technique, when there is one.
+    pub fn gi_mut(&mut self) -> Option<&mut dyn Technique> {
+        self.gi.as_mut().map(|(technique, _)| &mut **technique)
     }
 
-    /// GPU memory of the voxel volumes or of the octree, by name (empty without GI).
+    /// The GI technique as the type `T`, when it is one.
+    pub fn gi_as<T: Technique>(&self) -> Option<&T> {
+        let any: &dyn std::any::Any = self.gi()?;
+        any.downcast_ref()
+    }
+
+    /// The GI technique as the type `T`, when it is one.
+    pub fn gi_as_mut<T: Technique>(&mut self) -> Option<&mut T> {
+        let any: &mut dyn std::any::Any = self.gi_mut()?;
+        any.downcast_mut()
+    }
+
+    /// The debug views of this renderer's technique, in the viewer's cycling order (none
+    /// without GI).
+    pub fn debug_views(&self) -> Vec<DebugView> {
+        self.gi().map_or_else(Vec::new, |t| {
+            DebugView::SCREEN
+                .into_iter()
+                .chain(t.debug_views().iter().copied())
+                .collect()
+        })
+    }
+
+    /// GPU memory of the technique's resources, by name (empty without GI).
     pub fn gi_memory_bytes(&self) -> Vec<(&'static str, u64)> {
-        self.gi
-            .as_ref()
-            .map_or_else(Vec::new, VoxelGi::memory_bytes)
+        self.gi().map_or_else(Vec::new, |t| t.memory_bytes())
     }
 
     /// Bytes of GPU memory held by scene textures.
@@ -502,7 +312,7 @@ impl Renderer {
                 flags |= flag;
             }
         }
-        let gi_on = self.indirect && s.gi.is_some();
+        let gi_on = self.active_gi().is_some();
         if gi_on {
             for (on, flag) in [
                 (t.indirect_diffuse, layout::FLAG_INDIRECT_DIFFUSE),
@@ -512,7 +322,7 @@ impl Renderer {
                     layout::FLAG_TRANSMISSION,
                 ),
                 (t.ambient_occlusion, layout::FLAG_AO),
-                (self.shadow_cones_active(), layout::FLAG_SHADOW_CONES),
+                (self.gi_shades_direct(), layout::FLAG_SHADOW_CONES),
             ] {
                 if on {
                     flags |= flag;
@@ -541,43 +351,6 @@ impl Renderer {
         }
     }
 
-    fn gpu_lights(&self, time_s: f32) -> Vec<GpuLight> {
-        let mut first_view = 0;
-        (0..self.scene.lights.len())
-            .map(|i| {
-                let light = self.scene.light_at(i, time_s);
-                let views = shadow::view_count(&light);
-                let (kind, direction, cos_outer, cos_inner) = match light.kind {
-                    LightKind::Point => (layout::LIGHT_POINT, Vec3::ZERO, -1.0, -1.0),
-                    LightKind::Spot {
-                        direction,
-                        inner_deg,
-                        outer_deg,
-                    } => (
-                        layout::LIGHT_SPOT,
-                        direction.normalize(),
-                        outer_deg.to_radians().cos(),
-                        inner_deg.to_radians().cos(),
-                    ),
-                    LightKind::Directional { direction } => {
-                        (layout::LIGHT_DIRECTIONAL, direction.normalize(), -1.0, -1.0)
-                    }
-                };
-                let gpu = GpuLight {
-                    position: light.position.extend(1.0).to_array(),
-                    intensity: light.intensity.extend(0.0).to_array(),
-                    direction: direction.extend(cos_outer).to_array(),
-                    kind,
-                    first_shadow_view: first_view,
-                    shadow_view_count: views,
-                    cos_inner,
-                };
-                first_view += views;
-                gpu
-            })
-            .collect()
-    }
-
     /// Waits until a frame slot is free and starts its command buffer.
     pub fn begin_frame(&mut self) -> Result<Frame> {
         let frame = self.ring.begin()?;
@@ -599,11 +372,10 @@ impl Renderer {
         let ctx = self.ctx.clone();
         let cmd = frame.cmd;
         let uniforms = self.frame_uniforms(time_s);
-        let lights = self.gpu_lights(time_s);
+        let lights = frame_data::gpu_lights(&self.scene, time_s);
         let views: Vec<ShadowView> =
             shadow::scene_views(&self.scene, time_s, self.settings.shadow_resolution);
-        let extent = self.extent();
-        let shadow_cones = self.shadow_cones_active();
+        let shadow_cones = self.gi_shades_direct();
         let data = &mut self.frames[frame.slot];
         data.uniforms.write(0, bytemuck::bytes_of(&uniforms));
         data.lights.write(0, bytemuck::cast_slice(&lights));
@@ -648,15 +420,19 @@ impl Renderer {
             .record(&ctx, cmd, &self.targets.gbuffer, &draw, normal_maps);
         timer.end(cmd);
 
-        let gi = self.gi.as_mut().filter(|_| self.indirect);
-        if let Some(gi) = gi {
-            let mut lighting: Vec<u8> = bytemuck::cast_slice(&lights).to_vec();
-            lighting.extend_from_slice(bytemuck::cast_slice(&views));
-            lighting.push(u8::from(shadow_cones));
-            gi.record_update(cmd, timer, &draw, frame.slot, &lighting)?;
+        let indirect = self.indirect;
+        let gi = self.gi.as_mut().filter(|_| indirect);
+        if let Some((technique, _)) = gi {
+            let inputs = FrameInputs {
+                draw: &draw,
+                slot: frame.slot,
+                lights: &lights,
+                views: &views,
+            };
+            technique.record_update(cmd, timer, &inputs)?;
         }
 
-        // With soft-shadow cones the GI's upsample pass shades every pixel.
+        // When the technique shades the direct light, the upsample shades every pixel.
         if !shadow_cones {
             timer.begin(cmd, "lighting");
             self.lighting.record(
@@ -678,11 +454,19 @@ impl Renderer {
                 ImageUse::COMPUTE_WRITE,
             );
         }
-        if let Some(gi) = self.gi.as_ref().filter(|_| self.indirect) {
-            let voxel_view = self.settings.debug_view.shows_voxels();
-            let ambient_occlusion =
-                self.settings.terms.ambient_occlusion || self.settings.debug_view == DebugView::Ao;
-            gi.record_gather(cmd, timer, data.set, extent, voxel_view, ambient_occlusion);
+        if let Some((technique, screen)) = self.gi.as_ref().filter(|_| indirect) {
+            let options = GatherOptions {
+                debug_view: self.settings.debug_view,
+                ambient_occlusion: self.settings.terms.ambient_occlusion
+                    || self.settings.debug_view == DebugView::Ao,
+            };
+            let gathered = technique.record_gather(cmd, timer, data.set, screen, &options);
+            if gathered == Gathered::Terms {
+                timer.begin(cmd, "upsample");
+                compute_to_compute(&ctx, cmd);
+                screen.record_upsample(cmd, data.set);
+                timer.end(cmd);
+            }
         }
 
         timer.begin(cmd, "composite");
@@ -773,41 +557,4 @@ impl Drop for Renderer {
             log::error!("waiting for the GPU before freeing the renderer: {e:#}");
         }
     }
-}
-
-/// Records a copy of mip 0, layer 0 of a colour image in TRANSFER_SRC layout to `buffer`.
-pub fn copy_image_to_buffer(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    image: vk::Image,
-    extent: vk::Extent2D,
-    buffer: vk::Buffer,
-) {
-    let region = vk::BufferImageCopy {
-        buffer_offset: 0,
-        buffer_row_length: 0,
-        buffer_image_height: 0,
-        image_subresource: vk::ImageSubresourceLayers {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            mip_level: 0,
-            base_array_layer: 0,
-            layer_count: 1,
-        },
-        image_offset: vk::Offset3D::default(),
-        image_extent: vk::Extent3D {
-            width: extent.width,
-            height: extent.height,
-            depth: 1,
-        },
-    };
-    unsafe {
-        ctx.device.cmd_copy_image_to_buffer(
-            cmd,
-            image,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            buffer,
-            &[region],
-        )
-    };
-    copies_to_host_barrier(ctx, cmd);
 }

@@ -25,17 +25,17 @@ pub struct SceneDraw<'a> {
 impl SceneDraw<'_> {
     /// Binds `pipeline` and the geometry, then draws every mesh that `keep` accepts with
     /// its model matrix and material in the push constants; `shadow_view` selects the
-    /// shadow view. `pass_set` is bound as set 2 when given.
+    /// shadow view. `gi_set` (a GI technique's own) is bound as set 3 when given.
     pub fn draw_meshes(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         pipeline: &Pipeline,
         shadow_view: u32,
-        pass_set: Option<vk::DescriptorSet>,
+        gi_set: Option<vk::DescriptorSet>,
         keep: impl Fn(&crate::scene::Mesh) -> bool,
     ) {
-        self.for_each_mesh(ctx, cmd, pipeline, pass_set, keep, |draw, mut push| {
+        self.for_each_mesh(ctx, cmd, pipeline, gi_set, keep, |draw, mut push| {
             push.shadow_view = shadow_view;
             pipeline.push(
                 cmd,
@@ -55,7 +55,7 @@ impl SceneDraw<'_> {
         });
     }
 
-    /// Binds the compute `pipeline` and `pass_set` (set 2, which holds the geometry as
+    /// Binds the compute `pipeline` and `gi_set` (set 3, which holds the geometry as
     /// storage buffers), then dispatches workgroups for every triangle of every mesh that
     /// `keep` accepts, with its model matrix, material, first index and vertex offset in
     /// the push constants: `slices(longest edge in world units)` workgroups per triangle
@@ -66,7 +66,7 @@ impl SceneDraw<'_> {
         ctx: &Context,
         cmd: vk::CommandBuffer,
         pipeline: &Pipeline,
-        pass_set: vk::DescriptorSet,
+        gi_set: vk::DescriptorSet,
         max_groups: [u32; 2],
         slices: impl Fn(f32) -> u32,
         keep: impl Fn(&crate::scene::Mesh) -> bool,
@@ -87,10 +87,10 @@ impl SceneDraw<'_> {
                 unsafe { ctx.device.cmd_dispatch(cmd, groups, along_y, 1) };
             }
         };
-        self.for_each_mesh(ctx, cmd, pipeline, Some(pass_set), keep, record);
+        self.for_each_mesh(ctx, cmd, pipeline, Some(gi_set), keep, record);
     }
 
-    /// Binds `pipeline`, set 0, `pass_set` and (for draws) the geometry, then for every
+    /// Binds `pipeline`, set 0, `gi_set` and (for draws) the geometry, then for every
     /// mesh that `keep` accepts binds its material's set and calls `record` with its
     /// draw and push constants (model matrix and material).
     fn for_each_mesh(
@@ -98,13 +98,13 @@ impl SceneDraw<'_> {
         ctx: &Context,
         cmd: vk::CommandBuffer,
         pipeline: &Pipeline,
-        pass_set: Option<vk::DescriptorSet>,
+        gi_set: Option<vk::DescriptorSet>,
         keep: impl Fn(&crate::scene::Mesh) -> bool,
         mut record: impl FnMut(&Draw, DrawPush),
     ) {
         pipeline.bind(cmd, &[(layout::SET_FRAME, self.frame_set)]);
-        if let Some(set) = pass_set {
-            pipeline.bind_set(cmd, layout::SET_PASS, set);
+        if let Some(set) = gi_set {
+            pipeline.bind_set(cmd, layout::SET_GI, set);
         }
         if !pipeline.is_compute() {
             self.gpu.bind_geometry(ctx, cmd);

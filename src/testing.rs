@@ -5,33 +5,58 @@ use std::sync::Arc;
 use ash::vk;
 
 use crate::frontend::{Offscreen, LDR_FORMAT};
-use crate::gi::voxelize::Voxelizer;
-use crate::gi::{ConeSettings, VoxelStructure};
-use crate::renderer::{GiSettings, OutputTarget, RenderSettings, Renderer};
+use crate::gi::vct::voxelize::Voxelizer;
+use crate::gi::vct::{ConeTracing, Dense, Octree, Store, VctSettings};
+use crate::gi::GiSettings;
+use crate::renderer::{OutputTarget, Renderer};
 use crate::scene::Scene;
+use crate::settings::RenderSettings;
 use crate::vk::{Context, ContextOptions, ImageUse};
 
-/// GI settings with default cones at `voxels` per axis.
-pub fn gi_settings(voxels: u32, structure: VoxelStructure, full_update: bool) -> RenderSettings {
+/// Cone tracing with default cones at `voxels` per axis in `store`.
+pub fn gi_settings(voxels: u32, store: Store, full_update: bool) -> RenderSettings {
     RenderSettings {
-        gi: Some(GiSettings {
-            voxels,
-            structure,
-            cones: ConeSettings::default(),
-            shadow_cones: false,
+        gi: GiSettings::ConeTracing(VctSettings {
             full_update,
-            voxelizer: Default::default(),
+            ..VctSettings::new(voxels, store)
         }),
         ..Default::default()
     }
 }
 
+/// The cone tracer's settings in `settings`.
+pub fn cone_settings(settings: &mut RenderSettings) -> &mut VctSettings {
+    match &mut settings.gi {
+        GiSettings::ConeTracing(vct) => vct,
+        GiSettings::Off => panic!("the settings have no cone tracing"),
+    }
+}
+
 /// `settings` with the GI voxelized by `voxelizer`.
 pub fn with_voxelizer(mut settings: RenderSettings, voxelizer: Voxelizer) -> RenderSettings {
-    if let Some(gi) = settings.gi.as_mut() {
-        gi.voxelizer = voxelizer;
-    }
+    cone_settings(&mut settings).voxelizer = voxelizer;
     settings
+}
+
+/// The renderer's cone tracer over the dense grid.
+pub fn dense(renderer: &Renderer) -> &ConeTracing<Dense> {
+    renderer
+        .gi_as()
+        .expect("the renderer traces cones through a dense grid")
+}
+
+/// The renderer's cone tracer over the octree.
+pub fn octree(renderer: &Renderer) -> &ConeTracing<Octree> {
+    renderer
+        .gi_as()
+        .expect("the renderer traces cones through an octree")
+}
+
+/// The renderer's cone tracer over the octree.
+pub fn octree_mut(renderer: &mut Renderer) -> &mut ConeTracing<Octree> {
+    renderer
+        .gi_as_mut()
+        .expect("the renderer traces cones through an octree")
 }
 
 /// Renders 64x64 frames of `scene`, one at each of `times`, with validation on (its

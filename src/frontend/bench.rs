@@ -35,9 +35,9 @@ pub struct BenchReport {
     pub wall_median_ms: f64,
     pub memory_mib: BTreeMap<String, f64>,
     pub stats: BTreeMap<String, f64>,
-    /// GPU milliseconds per pass of the sparse voxel octree's build (`--gi svo`).
+    /// GPU milliseconds per pass of the technique's preparation (the octree's build).
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
-    pub svo_build_ms: BTreeMap<String, f64>,
+    pub prepare_ms: BTreeMap<String, f64>,
 }
 
 pub fn median(values: &mut [f64]) -> f64 {
@@ -137,30 +137,17 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
         memory_mib.insert(name.to_string(), mib(bytes));
     }
     let mut stats_map = BTreeMap::new();
-    let mut build_passes = Vec::new();
+    let mut prepare_passes = Vec::new();
     stats_map.insert("triangles".to_string(), triangles as f64);
     if let Some(gi) = renderer.gi() {
-        stats_map.insert("voxels".to_string(), f64::from(gi.grid.resolution));
-        if gi.octree().is_none() {
-            let albedo = gi.download(crate::gi::Volume::Albedo, 0)?;
-            let occupied = albedo.chunks_exact(4).filter(|t| t[3] > 0).count();
-            stats_map.insert("occupied_voxels".to_string(), occupied as f64);
+        stats_map.extend(gi.stats()?);
+        if let Some(preparation) = gi.preparation() {
+            println!("{}, GPU ms per pass:", preparation.summary);
+            for (name, ms) in &preparation.passes {
+                println!("  {name:<14} {ms:9.2}");
+            }
+            prepare_passes = preparation.passes;
         }
-    }
-    if let Some(svo) = renderer.gi().and_then(|gi| gi.octree()) {
-        let build = svo.report().context("the octree was not built")?;
-        stats_map.insert("octree_depth".to_string(), f64::from(svo.depth));
-        stats_map.extend(build.stats(&svo.capacities()));
-        println!(
-            "octree build ({}^3 effective, {} attempt(s), {:.1} ms wall), GPU ms per pass:",
-            svo.grid.resolution,
-            build.regrowths.len() + 1,
-            build.wall_ms
-        );
-        for (name, ms) in &build.passes {
-            println!("  {name:<14} {ms:9.2}");
-        }
-        build_passes = build.passes.clone();
     }
     let report = BenchReport {
         device: ctx.device_name(),
@@ -174,7 +161,7 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
         wall_median_ms: median(&mut walls),
         memory_mib,
         stats: stats_map,
-        svo_build_ms: build_passes.into_iter().collect(),
+        prepare_ms: prepare_passes.into_iter().collect(),
     };
     print_table(&report);
     if let Some(path) = &args.json {

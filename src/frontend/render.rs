@@ -9,8 +9,8 @@ use ash::vk;
 use super::{check_validation, create_context, load_scene, Offscreen};
 use crate::cli::{RenderArgs, MAX_IMAGE_SIDE};
 use crate::imageio::{box_downsample, box_downsample_srgb8};
-use crate::renderer::{copy_image_to_buffer, OutputTarget, Renderer};
-use crate::vk::{Buffer, ImageUse};
+use crate::renderer::{OutputTarget, Renderer};
+use crate::vk::{copy_image_to_buffer, Buffer, ImageUse};
 
 enum Format {
     Png,

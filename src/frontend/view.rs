@@ -2,10 +2,11 @@
 //!
 //! Controls: drag with the left mouse button to look around, W/A/S/D to move, Q/E to
 //! go down/up, Shift to move faster; arrow keys move the first light in X/Z and
-//! PageUp/PageDown in Y; Escape quits. With `--gi dense`: G turns the GI off and on;
+//! PageUp/PageDown in Y; Escape quits. With a GI technique: G turns the GI off and on;
 //! 1 to 6 switch the terms (direct, indirect diffuse, indirect specular, transmission,
-//! ambient occlusion, emission); C switches between shadow maps and soft-shadow cones;
-//! V cycles the debug views and [ / ] pick the voxel views' mip level.
+//! ambient occlusion, emission); V cycles the debug views and [ / ] pick the views' mip
+//! level; the technique's own switches have their keys too (the cone tracer's C: shadow
+//! maps or soft-shadow cones).
 
 use std::collections::HashSet;
 use std::ffi::CStr;
@@ -25,9 +26,8 @@ use winit::window::{Window, WindowId};
 
 use super::{check_validation, create_context, load_scene};
 use crate::cli::ViewArgs;
-use crate::gi::VoxelStructure;
-use crate::renderer::{copy_image_to_buffer, DebugView, OutputTarget, Renderer};
-use crate::vk::{Acquired, Buffer, Context, ImageUse, Swapchain};
+use crate::renderer::{OutputTarget, Renderer};
+use crate::vk::{copy_image_to_buffer, Acquired, Buffer, Context, ImageUse, Swapchain};
 
 /// Everything that exists while the window is open.
 struct Viewer {
@@ -299,13 +299,16 @@ impl Viewer {
         let renderer = &mut self.renderer;
         if code == KeyCode::KeyG {
             if renderer.gi().is_none() {
-                return Some("no indirect light: start with --gi dense to have it".into());
+                return Some(
+                    "no indirect light: start with --gi dense or --gi octree to have it".into(),
+                );
             }
             let on = renderer.toggle_indirect();
             return Some(format!("indirect light {}", if on { "on" } else { "off" }));
         }
+        let views = renderer.debug_views();
+        let levels = renderer.gi()?.debug_levels();
         let settings = &mut renderer.settings;
-        let gi = settings.gi.as_mut()?;
         let terms = &mut settings.terms;
         let (name, on) = match code {
             KeyCode::Digit1 => ("direct light", &mut terms.direct),
@@ -314,14 +317,7 @@ impl Viewer {
             KeyCode::Digit4 => ("transmission", &mut terms.transmission),
             KeyCode::Digit5 => ("ambient occlusion", &mut terms.ambient_occlusion),
             KeyCode::Digit6 => ("emission", &mut terms.emission),
-            KeyCode::KeyC => ("soft-shadow cones", &mut gi.shadow_cones),
             KeyCode::KeyV => {
-                // The octree view only where there is an octree.
-                let octree = matches!(gi.structure, VoxelStructure::Octree { .. });
-                let views: Vec<DebugView> = DebugView::ALL
-                    .into_iter()
-                    .filter(|v| octree || *v != DebugView::OctreeNodes)
-                    .collect();
                 let next = views
                     .iter()
                     .position(|v| *v == settings.debug_view)
@@ -334,11 +330,21 @@ impl Viewer {
                 *level = if code == KeyCode::BracketLeft {
                     level.saturating_sub(1)
                 } else {
-                    (*level + 1).min(gi.voxels.trailing_zeros())
+                    (*level + 1).min(levels)
                 };
                 return Some(format!("voxel view mip level {level}"));
             }
-            _ => return None,
+            _ => {
+                let key = letter(code)?;
+                let mut switches = renderer.gi_mut()?.switches();
+                let switch = switches.iter_mut().find(|s| s.key == key)?;
+                *switch.on = !*switch.on;
+                return Some(format!(
+                    "{} {}",
+                    switch.name,
+                    if *switch.on { "on" } else { "off" }
+                ));
+            }
         };
         *on = !*on;
         Some(format!("{name} {}", if *on { "on" } else { "off" }))
@@ -490,5 +496,15 @@ impl ApplicationHandler for App {
         if let Some(viewer) = &self.viewer {
             viewer.window.request_redraw();
         }
+    }
+}
+
+/// The lower-case letter of a letter key (winit names them `KeyA` to `KeyZ`).
+fn letter(code: KeyCode) -> Option<char> {
+    let name = format!("{code:?}");
+    let mut chars = name.strip_prefix("Key")?.chars();
+    match (chars.next(), chars.next()) {
+        (Some(c), None) => Some(c.to_ascii_lowercase()),
+        _ => None,
     }
 }

@@ -8,6 +8,7 @@ mod camera;
 mod file;
 mod light;
 mod obj;
+mod reference;
 mod texture;
 
 use std::path::{Path, PathBuf};
@@ -219,7 +220,7 @@ impl Scene {
         let mut scene = if name.ends_with(".toml") {
             file::load_toml(path, options)?
         } else if name.ends_with(".json") {
-            file::load_reference_json(path, options)?
+            reference::load_reference_json(path, options)?
         } else if name.ends_with(".obj") {
             file::load_bare_obj(path, options)?
         } else {

@@ -153,6 +153,38 @@ pub fn stage_barrier(
     );
 }
 
+/// A global barrier between two compute passes: writes before are visible to reads and
+/// writes after.
+pub fn compute_to_compute(ctx: &Context, cmd: vk::CommandBuffer) {
+    let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
+    memory_barrier(
+        ctx,
+        cmd,
+        (compute, vk::AccessFlags2::SHADER_WRITE),
+        (
+            compute,
+            vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE,
+        ),
+    );
+}
+
+/// Moves new `images` into the layout compute passes write them in, and waits.
+pub fn to_compute_write(ctx: &Arc<Context>, name: &str, images: &[&Image]) -> Result<()> {
+    OneShot::new(ctx)?.run(name, |cmd| {
+        for image in images {
+            image_barrier(
+                ctx,
+                cmd,
+                image.raw,
+                image.full_range(),
+                ImageUse::UNDEFINED,
+                ImageUse::COMPUTE_WRITE,
+            );
+        }
+        Ok(())
+    })
+}
+
 /// Clears every level and layer of a colour image to zero (all bits: any format), which
 /// was in state `before` and is left in state `after`; its contents are discarded.
 pub fn clear_to_zero(
@@ -182,6 +214,44 @@ pub fn clear_to_zero(
         )
     };
     image_barrier(ctx, cmd, image.raw, range, ImageUse::TRANSFER_DST, after);
+}
+
+/// Records a copy of mip 0, layer 0 of a colour image in TRANSFER_SRC layout to `buffer`,
+/// made visible to the host.
+pub fn copy_image_to_buffer(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    extent: vk::Extent2D,
+    buffer: vk::Buffer,
+) {
+    let region = vk::BufferImageCopy {
+        buffer_offset: 0,
+        buffer_row_length: 0,
+        buffer_image_height: 0,
+        image_subresource: vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        },
+        image_offset: vk::Offset3D::default(),
+        image_extent: vk::Extent3D {
+            width: extent.width,
+            height: extent.height,
+            depth: 1,
+        },
+    };
+    unsafe {
+        ctx.device.cmd_copy_image_to_buffer(
+            cmd,
+            image,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            buffer,
+            &[region],
+        )
+    };
+    copies_to_host_barrier(ctx, cmd);
 }
 
 /// Makes the copies recorded before it visible to host reads of their buffers (after the

@@ -1,0 +1,87 @@
+#version 460
+// variant: OCTREE
+// variant: AMBIENT_OCCLUSION
+// variant: OCTREE AMBIENT_OCCLUSION
+// Voxel cone tracing (Crassin et al. 2011) for one G-buffer pixel of each
+// indirect_scale² block: cosine-weighted diffuse cones over the normal's hemisphere are
+// marched front to back through the voxel radiance, the sky filling what they leave
+// unoccluded (alpha: ambient occlusion); then the soft-shadow cones towards the lights,
+// the specular cone along the reflected view ray and, on transmissive surfaces, the
+// refraction cone. The upsample pass spreads the results to every pixel. Every cone is
+// traced here: a cone march compiled into the full-resolution upsample pass made it
+// twice as slow on lavapipe even where it never ran.
+#include "common/direct_light.glsl"
+#include "gi/vct/cones.glsl"
+#include "gi/screen/screen.glsl"
+
+layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
+layout(set = SET_SCREEN, binding = BINDING_SCREEN_INDIRECT, rgba16f) uniform writeonly image2D indirect;
+layout(set = SET_SCREEN, binding = BINDING_SCREEN_SHADOW, rgba16f) uniform writeonly image2D shadow;
+layout(set = SET_SCREEN, binding = BINDING_SCREEN_SPECULAR, rgba16f) uniform writeonly image2D specular;
+layout(set = SET_SCREEN, binding = BINDING_SCREEN_TRANSMITTED, rgba16f) uniform writeonly image2D transmitted;
+
+void main() {
+    ivec2 low = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(low, imageSize(indirect)))) {
+        return;
+    }
+    ivec2 pixel = representative(low);
+    float depth = texelFetch(gbuffer_depth, pixel, 0).r;
+    if (depth >= 1.0) {
+        imageStore(indirect, low, vec4(0.0, 0.0, 0.0, 1.0));
+        return;
+    }
+    vec3 p = pixel_position(pixel, depth);
+    vec4 normal_roughness = imageLoad(gbuffer_normal, pixel);
+    vec3 n = normalize(normal_roughness.xyz);
+    // Start two voxels off the surface so the cones do not gather their own voxels, and
+    // sample no finer than 2-voxel cells (the base level adds nothing measurable here:
+    // BENCHMARKS.md, the dense grid's quality history).
+    // Ambient occlusion costs one more sample per step: only when shown or applied, in
+    // its own variant (lavapipe runs this pass 15 % slower with the sampling code merely
+    // compiled in).
+#ifdef AMBIENT_OCCLUSION
+    const bool with_ao = true;
+#else
+    const bool with_ao = false;
+#endif
+    vec3 start = p + n * (2.0 * vct.origin.w);
+    imageStore(indirect, low, gather_diffuse(p, start, n, int(vct.diffuse_cones), 1.0, with_ao, vct.step_factor, true));
+    // Soft shadows change at the scale of the voxels, like the indirect light: their
+    // cones are traced here too, four lights to a band of rows.
+    if ((frame.flags & FLAG_SHADOW_CONES) != 0u) {
+        for (uint band = 0u; band * 4u < frame.light_count; band++) {
+            vec4 visibility = vec4(1.0);
+            for (uint i = 0u; i < 4u && band * 4u + i < frame.light_count; i++) {
+                vec3 l;
+                float dist;
+                if (any(greaterThan(light_incident(lights[band * 4u + i], p, n, l, dist), vec3(0.0)))) {
+                    visibility[i] = cone_visibility(start, l, vct.shadow_tan_half, dist - vct.origin.w);
+                }
+            }
+            imageStore(shadow, shadow_texel(low, band), visibility);
+        }
+    }
+    // The specular and refraction cones too: at 64^3 voxels a reflection is no sharper
+    // than a few voxels. Their half-angle follows the roughness: tan(half) ~ roughness.
+    // One call site for both keeps the shader small (lavapipe inlines every call).
+    vec3 v = normalize(frame.camera_position.xyz - p);
+    float roughness = clamp(normal_roughness.w, 0.02, 1.0);
+    vec2 transmission = imageLoad(gbuffer_transmission, pixel).rg;
+    bool traced[2] = bool[2](
+        imageLoad(gbuffer_albedo, pixel).a > 0.0 && (frame.flags & FLAG_INDIRECT_SPECULAR) != 0u,
+        transmission.r > 0.0 && (frame.flags & FLAG_TRANSMISSION) != 0u);
+    // n faces the camera: the refracted ray enters the surface (relative index 1 / Ni).
+    vec3 refracted = refract(-v, n, 1.0 / max(transmission.g, 1.0));
+    vec3 dirs[2] = vec3[2](reflect(-v, n), dot(refracted, refracted) > 0.0 ? refracted : reflect(-v, n));
+    vec4 radiance[2] = vec4[2](vec4(0.0), vec4(0.0));
+    for (int c = 0; c < 2; c++) {
+        if (traced[c]) {
+            // The cone leaves the surface on the side it points to.
+            vec3 side = dot(dirs[c], n) < 0.0 ? -n : n;
+            radiance[c] = vec4(trace_cone(p + side * (2.0 * vct.origin.w), dirs[c], roughness, 0.0, p, side, -1, vct.step_factor).rgb, 1.0);
+        }
+    }
+    imageStore(specular, low, radiance[0]);
+    imageStore(transmitted, low, radiance[1]);
+}

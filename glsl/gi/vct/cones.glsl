@@ -1,0 +1,288 @@
+// Cone marching through the voxel radiance (Crassin et al. 2011), shared by the screen
+// gather and the voxel bounce.
+#ifndef CONES_GLSL
+#define CONES_GLSL
+#include "common/frame.glsl"
+#include "gi/vct/sampling.glsl"
+
+// Per axis, the share of a cell of directional `level` centred at `uvw` (two cells
+// wide: the trilinear tent) that lies inside the grid.
+vec3 cross_section_inside(vec3 uvw, float level) {
+    float h = exp2(max(level, 0.0)) / float(vct.resolution);
+    return clamp((min(uvw + h, 1.0) - max(uvw - h, 0.0)) / (2.0 * h), 0.0, 1.0);
+}
+
+// Voxel radiance at `uvw` for a cone travelling along `dir`, from the three directional
+// volumes facing the cone at mip `level`, weighted by the squared direction components
+// w. The optical depths add up, weighted by w, so the transmittance is the product of
+// the three raised to w: a wall opaque along one axis stays opaque to any cone that
+// crosses it, where a weighted mean of the opacities would let a cone at 45 degrees see
+// half through it (and light leave the room). The colour is the opacity-weighted mean
+// of the three.
+// Each volume is weighted by the share of the cell's cross-section across its axis that
+// lies inside the grid: the grid covers the scene, so nothing lies beyond its faces,
+// where the clamped lookup would repeat the edge cells (the walls and floor at an open
+// side of the scene, as if they went on).
+vec4 sample_directional_volumes(vec3 uvw, vec3 dir, float level) {
+    vec3 w = dir * dir;
+    vec4 sx;
+    vec4 sy;
+    vec4 sz;
+    sample_facing(uvw, dir, level, sx, sy, sz);
+    vec3 inside = cross_section_inside(uvw, level);
+    sx *= inside.y * inside.z;
+    sy *= inside.x * inside.z;
+    sz *= inside.x * inside.y;
+    vec4 mean = w.x * sx + w.y * sy + w.z * sz;
+    vec3 transmittance = 1.0 - clamp(vec3(sx.a, sy.a, sz.a), 0.0, 0.9999);
+    float alpha = 1.0 - exp2(dot(w, log2(transmittance)));
+    return mean.a > 1e-4 ? vec4(mean.rgb * (alpha / mean.a), alpha) : vec4(0.0);
+}
+
+// Voxel radiance at `uvw` for a cone travelling along `dir` with footprint `lod` (0 = one
+// voxel): the base level below lod 1, blended into the directional volumes above.
+vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
+    vec4 base = sample_base(uvw);
+    if (lod <= 0.0) {
+        return base;
+    }
+    vec4 aniso = sample_directional_volumes(uvw, dir, max(lod - 1.0, 0.0));
+    return lod < 1.0 ? mix(base, aniso, lod) : aniso;
+}
+
+// Where a cone leaving the surface at `surface` with normal `n` samples at distance
+// `dist` from `origin` (texture coordinates), with the cone `diameter` there (which sets
+// the step) and the `footprint` the sample reads at (mip `lod`).
+// A cone 57.5 degrees off the normal with a 30 degree half-angle nearly grazes the
+// surface's own plane, and the trilinear lookup blends cells up to one cell size from
+// the sample point: the surface would occlude and light itself (its lit voxels seen
+// edge-on).
+// So the footprint is capped at the sample's height above the plane, and a sample less
+// than 1.125 footprints above it (where the coarsest level, min_lod, still blends from
+// the plane) is lifted to that height along n: an eighth of a cell more than the
+// footprint keeps more of the plane's own cell out of the blend, where a quarter cell
+// bends the ring cones too far, and lifting every sample a whole cone diameter bends the
+// slanted cones towards the normal, far off their axis (BENCHMARKS.md, the dense grid's
+// quality history).
+vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lod, vec3 surface, vec3 n,
+                 out float lod, out float diameter, out float footprint) {
+    float voxel = vct.origin.w;
+    vec3 x = origin + dir * dist;
+    float height = dot(x - surface, n);
+    diameter = max(voxel, 2.0 * tan_half * dist);
+    lod = max(log2(min(diameter, max(height, voxel)) / voxel), min_lod);
+    // The cell size at that mip, also where min_lod holds the mip above what the cone
+    // asks for (its opacity was filtered over that path).
+    footprint = voxel * exp2(lod);
+    x += n * max(1.125 * footprint - height, 0.0);
+    return (x - vct.origin.xyz) / (voxel * float(vct.resolution));
+}
+
+bool inside_grid(vec3 uvw) {
+    return all(greaterThanEqual(uvw, vec3(0.0))) && all(lessThanEqual(uvw, vec3(1.0)));
+}
+
+// Where the segment from `a` (inside the grid) to `b` (outside) crosses the grid's
+// faces, as a fraction of the segment.
+float grid_exit(vec3 a, vec3 b) {
+    vec3 span = b - a;
+    vec3 low = mix(vec3(1e9), -a / span, lessThan(b, vec3(0.0)));
+    vec3 high = mix(vec3(1e9), (1.0 - a) / span, greaterThan(b, vec3(1.0)));
+    vec3 t = min(low, high);
+    return clamp(min(t.x, min(t.y, t.z)), 0.0, 1.0);
+}
+
+// The path, in footprints, that the grid's face counts where a cone leaves the grid.
+// The scene's bounds often lie on a wall (a room's), whose voxels fill the grid's last
+// layer; with linear interpolation of opacity the march integrates only the inner half
+// of that layer's tent, and the wall would let about a tenth of the light through. Half
+// a footprint stands for the outer half; 0.65 is the best of a sweep with the screen's
+// ring cones traced as sub-cones (BENCHMARKS.md, the dense grid's quality history,
+// sessions 10 and 11).
+const float GRID_FACE_PATH = 0.65;
+
+// Front-to-back accumulation along one cone leaving the surface at `surface` with normal
+// `n`; returns premultiplied radiance (rgb) with the sky behind whatever the cone leaves
+// open, and (a) the occlusion that ambient occlusion counts, each occluder weighted down
+// with its distance d by 1 / (1 + d / vct.ao_distance). Ambient occlusion reads opacity
+// from the one directional volume `ao_volume` (0..5, or -1: none) travelling away from
+// the surface along the axis closest to its normal: the surface's own voxels are hidden
+// from it by the filter's facing weight, whereas the three volumes a slanted cone blends
+// see them edge-on, so an open plane would occlude itself. Each step is `step_factor` of
+// the cone's diameter there.
+vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surface, vec3 n, int ao_volume,
+                float step_factor) {
+    vec4 acc = vec4(0.0);
+    float ao = 0.0;
+    float ao_alpha = 0.0;
+    float dist = vct.origin.w;
+    float lod;
+    float diameter;
+    float footprint;
+    vec3 uvw = cone_sample(origin, dir, dist, tan_half, min_lod, surface, n, lod, diameter, footprint);
+    bool at_face = false;
+    while (acc.a < 0.99 && dist < vct.max_distance && inside_grid(uvw)) {
+        // Cones that never sample below lod 1 (the diffuse ones) skip the base level: the
+        // branch is on a constant once inlined, where testing lod per sample cost more
+        // than the fetch it saves.
+        vec4 s;
+        if (min_lod >= 1.0) {
+            s = sample_directional_volumes(uvw, dir, lod - 1.0);
+        } else {
+            s = sample_voxels(uvw, dir, lod);
+        }
+        // Wide cones may instead step level by level: each sample at twice the last's
+        // distance, so twice as wide, reading the next coarser level (min_lod marks them).
+        float step_length = (vct.wide_steps_by_level != 0u && min_lod >= 1.0) ? max(dist, diameter * step_factor)
+                                                                              : diameter * step_factor;
+        float next_lod;
+        float next_diameter;
+        float next_footprint;
+        vec3 next_uvw = cone_sample(origin, dir, dist + step_length, tan_half, min_lod, surface, n, next_lod,
+                                    next_diameter, next_footprint);
+        // Opacity was filtered for a path of one footprint; correct it to the path from
+        // this sample to the next: the step, longer where the lift bends it. The last
+        // step inside the grid ends at its face, so that what a cone gathers changes
+        // smoothly as its origin moves (a whole step there drew bands in the indirect
+        // light wherever one more sample fell inside the grid).
+        bool leaving = !inside_grid(next_uvw);
+        float exit_fraction = leaving ? grid_exit(uvw, next_uvw) : 1.0;
+        float path = distance(next_uvw, uvw) * vct.origin.w * float(vct.resolution) * exit_fraction;
+        float footprints = at_face ? GRID_FACE_PATH : path / footprint;
+        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), footprints);
+        vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
+        acc.rgb += (1.0 - acc.a) * rgb;
+        acc.a += (1.0 - acc.a) * a;
+        if (ao_volume >= 0) {
+            float o = sample_directional(ao_volume, uvw, max(lod - 1.0, 0.0)).a;
+            o = 1.0 - pow(1.0 - clamp(o, 0.0, 0.9999), footprints);
+            ao += (1.0 - ao_alpha) * o / (1.0 + dist / vct.ao_distance);
+            ao_alpha += (1.0 - ao_alpha) * o;
+        }
+        if (at_face) {
+            break;
+        }
+        if (leaving) {
+            // One more sample, in the same loop (a separate fetch after it cost lavapipe
+            // as much as a step for every lane, on each step where any lane left): the
+            // face itself, what lies in it (a wall on the scene's bounds) for
+            // GRID_FACE_PATH footprints, read one level finer than the cone, so that
+            // walls running along the cone to an open face (a corridor's) count as the
+            // small share of the cell they are.
+            at_face = true;
+            uvw = clamp(mix(uvw, next_uvw, exit_fraction), 0.0, 1.0);
+            lod = max(lod - 1.0, min_lod);
+            continue;
+        }
+        dist += step_length;
+        uvw = next_uvw;
+        lod = next_lod;
+        diameter = next_diameter;
+        footprint = next_footprint;
+    }
+    acc.rgb += (1.0 - acc.a) * frame.sky_radiance.rgb;
+    return vec4(acc.rgb, ao);
+}
+
+// Fraction of the light from `dir` that reaches `origin` through the voxels within
+// `max_dist`: a soft-shadow cone, accumulating opacity only, stepping by
+// vct.shadow_step_factor of its diameter.
+float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
+    float voxel = vct.origin.w;
+    float grid_size = voxel * float(vct.resolution);
+    float occlusion = 0.0;
+    float dist = voxel;
+    while (occlusion < 0.99 && dist < max_dist) {
+        float diameter = max(voxel, 2.0 * tan_half * dist);
+        vec3 uvw = (origin + dir * dist - vct.origin.xyz) / grid_size;
+        if (!inside_grid(uvw)) {
+            break;
+        }
+        float s = sample_voxels(uvw, dir, log2(diameter / voxel)).a;
+        float step_length = diameter * vct.shadow_step_factor;
+        occlusion += (1.0 - occlusion) * (1.0 - pow(1.0 - clamp(s, 0.0, 0.9999), vct.shadow_step_factor));
+        dist += step_length;
+    }
+    return 1.0 - occlusion;
+}
+
+// A unit vector perpendicular to the unit vector `axis` (from the world's y axis, or x
+// where `axis` nearly is y): with cross(axis, it), the frame that cones are laid out in.
+vec3 perpendicular(vec3 axis) {
+    return normalize(abs(axis.y) < 0.9 ? cross(axis, vec3(0.0, 1.0, 0.0)) : cross(axis, vec3(1.0, 0.0, 0.0)));
+}
+
+// The screen's ring cones are each traced as sub-cones, narrower cones around their
+// axis that read finer levels: a 60-degree cone leaving a surface blends, in its coarse
+// cells, the surface's own lit voxels and walls seen edge-on that its rays never meet,
+// and a narrower cone blends less of them (per cone against the exact cone integrals,
+// BENCHMARKS.md, session 11). About 20 sub-cones go round the ring whatever its count
+// (the ring cones overlap more as there are more of them): four per cone up to five
+// cones (each 0.53 as wide, 0.47 of the half-angle off the axis, in a square around
+// it), two up to ten (0.63 as wide, 0.4 off), else none. They step as far as the cone
+// they stand for, so a sub-cone costs about one cone (stepping by their own width is
+// slightly better and twice as slow; the counts, widths and what is split are the best
+// of the sweeps in BENCHMARKS.md, session 11).
+vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surface, vec3 n, float step_factor,
+                     int ao_volume) {
+    if (parts == 1) {
+        return trace_cone(origin, dir, vct.diffuse_tan_half, min_lod, surface, n, ao_volume, step_factor);
+    }
+    float offset = atan(vct.diffuse_tan_half) * (parts == 4 ? 0.467 : 0.4);
+    float tan_half = vct.diffuse_tan_half * (parts == 4 ? 0.53 : 0.63);
+    // Evenly round the axis, half a step off a frame fixed to the world's y axis (laid
+    // out along and across the ring instead they score no better: BENCHMARKS.md).
+    vec3 u = perpendicular(dir);
+    vec3 v = cross(dir, u);
+    vec4 sum = vec4(0.0);
+    for (int i = 0; i < parts; i++) {
+        float phi = 6.2831853 * (float(i) + 0.5) / float(parts);
+        vec3 d = normalize(cos(offset) * dir + sin(offset) * (cos(phi) * u + sin(phi) * v));
+        sum += trace_cone(origin, d, tan_half, min_lod, surface, n, ao_volume,
+                          step_factor * vct.diffuse_tan_half / tan_half);
+    }
+    return sum / float(parts);
+}
+
+// Cosine-weighted mean radiance over the hemisphere around n of the surface at `surface`
+// from `cones` cones starting at `origin`: one along n, the others in a ring 57.5 degrees
+// from it (traced as sub-cones where `split_ring`: the screen's), each stepping
+// `step_factor` of its diameter. With `with_ao`, alpha is the ambient occlusion (1 where
+// nothing near occludes); else 1.
+// The ring at 57.5 degrees: with the exact cone integrals the best ring is 50-55 degrees
+// (the cosine-weighted mean direction of the band it stands for is 54.7), but the traced
+// cones read their ring best at 57.5 (a sweep of 54.7 to 60 degrees with sub-cones,
+// BENCHMARKS.md, session 11).
+vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod, bool with_ao, float step_factor,
+                    bool split_ring) {
+    vec3 t = perpendicular(n);
+    vec3 b = cross(n, t);
+    int ao_volume = -1;
+    if (with_ao) {
+        vec3 m = abs(n);
+        int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
+        ao_volume = 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
+    }
+    vec4 centre = trace_cone(origin, n, vct.diffuse_tan_half, min_lod, surface, n, ao_volume, step_factor);
+    int ring = cones - 1;
+    if (ring == 0) {
+        return vec4(centre.rgb, 1.0 - centre.a);
+    }
+    int parts = split_ring ? (ring <= 5 ? 4 : (ring <= 10 ? 2 : 1)) : 1;
+    vec4 around = vec4(0.0);
+    for (int i = 0; i < ring; i++) {
+        float phi = 6.2831853 * float(i) / float(ring);
+        vec3 dir = normalize(0.5373 * n + 0.8434 * (cos(phi) * t + sin(phi) * b));
+        around += trace_ring_cone(origin, dir, parts, min_lod, surface, n, step_factor, ao_volume);
+    }
+    // Cosine weights: a cone of half-angle 30 degrees at angle a from n holds
+    // pi sin^2(30) cos(a) of the cosine-weighted hemisphere: pi/4 along n, about pi/8 in
+    // the ring. Five such cones fill the ring; more overlap and share the ring's
+    // pi * 5/8, so its share does not grow with the count (the gaps towards the horizon
+    // are filled in proportion). (The band's own share, 3/4 against the cap's 1/4, scores
+    // worse with the traced cones: BENCHMARKS.md, session 11.)
+    float ring_share = 0.5 * float(min(ring, 5));
+    vec4 sum = (centre + ring_share * around / float(ring)) / (1.0 + ring_share);
+    return vec4(sum.rgb, 1.0 - sum.a);
+}
+#endif

@@ -1,0 +1,183 @@
+#version 460
+// variant: OCTREE
+// Deferred voxel shading (Villegas 2018), over the list of occupied voxels (the others
+// were cleared to zero): per occupied voxel, outgoing radiance =
+// albedo / pi * direct irradiance (the surface shading's units) + emission, stored
+// premultiplied by opacity. Visibility comes from the shadow maps (one bilinear compare:
+// a voxel is wider than the PCF kernel), or with soft-shadow cones, which make the
+// shadow maps unnecessary, from a ray marched through the voxels towards the light.
+// With OCTREE the voxels are the octree's leaf voxels, in their bricks. The radiance
+// is stored only where a bounce does not rewrite it before the next filter. Around
+// moving meshes (`push.cull`) only the voxels whose light can have changed are shaded
+// again: those in bricks given out this frame, and those a light reaches past where the
+// moving meshes were or are (`push.region_*`); the others keep their light.
+#include "common/frame.glsl"
+#include "common/direct_light.glsl"
+#include "gi/vct/voxels.glsl"
+#include "gi/vct/inject/radiance.glsl"
+
+layout(local_size_x = VOXEL_LIST_GROUP_SIZE) in;
+layout(set = SET_GI, binding = BINDING_VCT_ALBEDO, r32ui) uniform readonly uimage3D voxel_albedo;
+layout(set = SET_GI, binding = BINDING_VCT_NORMAL, r32ui) uniform uimage3D voxel_normal;
+layout(set = SET_GI, binding = BINDING_VCT_EMISSION, r32ui) uniform readonly uimage3D voxel_emission;
+layout(push_constant) uniform PushBlock {
+    InjectPush push;
+};
+layout(set = SET_GI, binding = BINDING_VCT_DIRECT, rgba16f) uniform image3D voxel_direct;
+
+// Whether voxel v of the grid holds a surface.
+bool voxel_occupied(ivec3 v) {
+#ifdef OCTREE
+    ivec3 texel;
+    return leaf_texel(uvec3(v), texel) && (imageLoad(voxel_albedo, texel).r >> 24) != 0u;
+#else
+    return (imageLoad(voxel_albedo, v).r >> 24) != 0u;
+#endif
+}
+
+// Whether the segment from p (offset along n) towards the light, up to `dist`, passes no
+// occupied voxel: one sample per voxel length.
+float voxel_visibility(vec3 p, vec3 n, vec3 to_light, float dist) {
+    float voxel = vct.origin.w;
+    vec3 start = p + n * (2.0 * voxel);
+    float end = min(dist - voxel, vct.max_distance);
+    for (float t = 0.0; t < end; t += voxel) {
+        ivec3 v = ivec3(floor((start + to_light * t - vct.origin.xyz) / voxel));
+        if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(vct.resolution)))) {
+            break;
+        }
+        if (voxel_occupied(v)) {
+            return 0.0;
+        }
+    }
+    return 1.0;
+}
+
+// Villegas' normal-weighted attenuation (2018, section 2.1): a voxel's averaged normal n
+// may point where none of its surfaces does (a floor meeting a wall averages to 45
+// degrees and would catch the light of both). Each axis face on n's side takes the
+// light at its own cosine, weighted by n's squared component on that axis.
+float voxel_attenuation(vec3 n, vec3 l) {
+    vec3 w = n * n;
+    vec3 d = max(sign(n) * l, vec3(0.0));
+    return dot(w, d);
+}
+
+#ifdef OCTREE
+// Whether the segment from p along the unit vector d, up to `dist`, meets the box
+// [lo, hi].
+bool segment_meets_box(vec3 p, vec3 d, float dist, vec3 lo, vec3 hi) {
+    vec3 inverse = 1.0 / mix(d, vec3(1e-12), lessThan(abs(d), vec3(1e-12)));
+    vec3 t0 = (lo - p) * inverse;
+    vec3 t1 = (hi - p) * inverse;
+    vec3 near = min(t0, t1);
+    vec3 far = max(t0, t1);
+    float enter = max(max(near.x, near.y), max(near.z, 0.0));
+    float exit = min(min(far.x, far.y), min(far.z, dist));
+    return enter <= exit;
+}
+
+// Whether the direct light of the voxel at p can differ from when it was last shaded
+// (the lights and shadow views are the same): only where the path to a light passes
+// the region where moving meshes were or are. The region grows by what the lookups
+// reach beyond that path: the shadow lookup's normal offset (two texels and half a
+// voxel) and its bilinear taps (a texel and a half), or the voxel ray-march's start
+// two voxels out and its cells around the ray; at p's distance a shadow texel is at
+// least as wide as where the path meets the region.
+bool light_may_change(vec3 p) {
+    float voxel = vct.origin.w;
+    vec3 lo = vct.origin.xyz + vec3(push.region_min.xyz) * voxel;
+    vec3 hi = vct.origin.xyz + vec3(push.region_max.xyz + 1) * voxel;
+    if (any(greaterThan(lo, hi))) {
+        return false;
+    }
+    for (uint i = 0u; i < frame.light_count; i++) {
+        GpuLight light = lights[i];
+        vec3 l;
+        float dist;
+        light_arriving(light, p, l, dist);
+        float texel = light.shadow_view_count == 0u ? 0.0 : shadow_texel_world(shadow_views[shadow_view_for(light, p)], p);
+        float margin = 4.0 * voxel + 4.0 * texel;
+        if (segment_meets_box(p, l, dist, lo - margin, hi + margin)) {
+            return true;
+        }
+    }
+    return false;
+}
+#endif
+
+// Irradiance at the voxel p on its side with (averaged) normal n from one light,
+// shadowed.
+vec3 voxel_irradiance(GpuLight light, vec3 p, vec3 n) {
+    vec3 l;
+    float dist;
+    vec3 e = light_arriving(light, p, l, dist) * voxel_attenuation(n, l);
+    if (all(equal(e, vec3(0.0)))) {
+        return e;
+    }
+    bool cones = (frame.flags & FLAG_SHADOW_CONES) != 0u;
+    return e * (cones ? voxel_visibility(p, n, l, dist) : shadow_visibility(light, p, n, 0.5 * vct.origin.w, 0));
+}
+
+void main() {
+    ListedVoxel entry;
+    if (!listed_voxel(entry)) {
+        return;
+    }
+    ivec3 voxel = entry.texel;
+    vec3 p = voxel_center(entry.voxel);
+#ifdef OCTREE
+    bool fresh = fresh_brick(entry);
+    if (push.cull != 0u && !fresh && !light_may_change(p)) {
+        return;
+    }
+#endif
+    vec4 albedo = unpack_rgba8(imageLoad(voxel_albedo, voxel).r);
+    vec3 rho = albedo.rgb / 255.0;
+    uint packed_normal = imageLoad(voxel_normal, voxel).r;
+    vec3 n = unpack_normal(packed_normal);
+    float len = length(n);
+    // Opposite normals averaged in one voxel cancel; such a voxel faces every way.
+    n = len > 0.2 ? n / len : vec3(0.0, 1.0, 0.0);
+    // Surfaces are two-sided: the voxel keeps the face that receives more light (emitters
+    // their winding face), and its normal is turned to that face so that the filter
+    // shows this radiance only to cones that look at the face. Turned exactly, so that
+    // shading the voxel again gives the same light.
+    vec3 front = vec3(0.0);
+    vec3 back = vec3(0.0);
+    for (uint i = 0u; i < frame.light_count; i++) {
+        front += voxel_irradiance(lights[i], p, n);
+        back += voxel_irradiance(lights[i], p, -n);
+    }
+    vec3 emission = unpack_rgba8(imageLoad(voxel_emission, voxel).r).rgb / 255.0 * vct.emission_range;
+    bool back_lit = dot(back, vec3(1.0)) > dot(front, vec3(1.0)) && all(equal(emission, vec3(0.0)));
+    vec3 e = len > 0.2 ? (back_lit ? back : front) : front + back;
+    if (len > 0.2 && back_lit) {
+        imageStore(voxel_normal, voxel, uvec4(flip_normal(packed_normal)));
+    }
+    vec4 radiance = vec4(rho / PI * e + emission, 1.0);
+#ifdef OCTREE
+    vec4 direct_before = imageLoad(voxel_direct, voxel);
+    // A light that moved: the bounces must run again (octree/bricks/bounce_dispatch.comp).
+    if (radiance_changed(radiance, direct_before)) {
+        bounce_dispatch.changed = 1u;
+    }
+#endif
+    imageStore(voxel_direct, voxel, radiance);
+#ifdef OCTREE
+    // Around moving meshes a voxel keeps the light its bounces gathered, as the dense
+    // grid's bounces start from last frame's filtered light: a voxel in a brick kept
+    // from last frame has it in its radiance beside the direct light it replaces; one in
+    // a new brick finds it in the carried light, by voxel.
+    if (push.keep_indirect != 0u && push.store_radiance != 0u) {
+        if (fresh) {
+            radiance.rgb += rho * carry_load(uvec3(entry.voxel));
+        } else {
+            radiance.rgb += max(imageLoad(shaded_radiance, entry.radiance_texel).rgb - direct_before.rgb, vec3(0.0));
+        }
+    }
+#endif
+    if (push.store_radiance != 0u) {
+        store_radiance(entry, radiance);
+    }
+}

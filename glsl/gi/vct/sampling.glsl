@@ -1,0 +1,168 @@
+// How cones read the filtered voxel radiance: the base level (one voxel wide) and the
+// six directional levels above it, from the dense grid's 3D textures or, with
+// OCTREE, from the octree's bricks (Dřínovský 2013, 5.6). Both give the same values:
+// a brick holds its node's 2x2x2 voxels, at voxel centres as in the dense grid, with a
+// border copied from the neighbours, so trilinear filtering inside a node, or up to half
+// a voxel outside it, reads what the dense texture would.
+#ifndef SAMPLING_GLSL
+#define SAMPLING_GLSL
+#include "gi/vct/voxels.glsl"
+
+layout(set = SET_GI, binding = BINDING_VCT_RADIANCE_SAMPLED) uniform sampler3D voxel_radiance;
+layout(set = SET_GI, binding = BINDING_VCT_DIRECTIONAL) uniform sampler3D voxel_directional;
+
+#ifndef OCTREE
+
+// The base level at `uvw`.
+vec4 sample_base(vec3 uvw) {
+    return textureLod(voxel_radiance, uvw, 0.0);
+}
+
+// The directional volume d (+X -X +Y -Y +Z -Z) at `uvw` and mip `level`, one trilinear
+// fetch blending two levels. The six sit side by side along x, each in the middle of a
+// slot twice its width whose margins repeat its edge voxels (filter.comp), so that
+// filtering clamps at the cube's faces as at the texture's and never mixes two
+// directions, at every level alike.
+vec4 sample_directional(int d, vec3 uvw, float level) {
+    float l = clamp(level, 0.0, float(vct.directional_levels) - 1.0);
+    float x = (float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / 6.0;
+    return textureLod(voxel_directional, vec3(x, uvw.yz), l);
+}
+
+// The three directional volumes facing a cone travelling along `dir`.
+void sample_facing(vec3 uvw, vec3 dir, float level, out vec4 sx, out vec4 sy, out vec4 sz) {
+    sx = sample_directional(dir.x >= 0.0 ? 0 : 1, uvw, level);
+    sy = sample_directional(dir.y >= 0.0 ? 2 : 3, uvw, level);
+    sz = sample_directional(dir.z >= 0.0 ? 4 : 5, uvw, level);
+}
+
+#else
+#include "gi/vct/octree/octree.glsl"
+
+// A place in a brick: the brick and the position in texels of its interior (0..2).
+struct BrickSample {
+    uint brick;
+    vec3 local;
+};
+
+// The brick of the node at `level` whose cube holds `uvw` (clamped to the grid, as the
+// dense sampler clamps to its edge), and where `uvw` lies in it; false where trilinear
+// filtering there reads only empty voxels. Where the node is missing or empty but the
+// 2x2x2 voxels the dense sampler would blend reach into a neighbouring node, that node's
+// brick is read instead: its border holds those voxels (zero where empty). Inside a
+// large empty cube the descent stops at its top and nothing more is looked up.
+bool locate(vec3 uvw, uint level, out BrickSample s) {
+    float voxels = float(2u << level);
+    vec3 q = clamp(uvw, 0.0, 1.0) * voxels;
+    uvec3 node_coords = min(uvec3(q * 0.5), uvec3((1u << level) - 1u));
+    uint empty;
+    uint node = find_node_or_gap_gridded(node_coords << (octree_depth() - level), level, empty);
+    s.brick = node == OCTREE_NO_NODE ? OCTREE_NO_BRICK : node_bricks[node];
+    s.local = q - vec3(node_coords * 2u);
+    if (s.brick != OCTREE_NO_BRICK) {
+        return true;
+    }
+    ivec3 last = ivec3(int(2u << level) - 1);
+    ivec3 lo = clamp(ivec3(floor(q - 0.5)), ivec3(0), last);
+    ivec3 hi = min(lo + 1, last);
+    // The empty cube around q, in voxels of this level.
+    int size = 2 << (level - empty);
+    ivec3 start = (ivec3(node_coords) >> (level - empty)) * size;
+    if (all(greaterThanEqual(lo, start)) && all(lessThan(hi, start + size))) {
+        return false;
+    }
+    ivec3 first = lo >> 1;
+    ivec3 span = (hi >> 1) - first;
+    for (int i = 0; i < 8; i++) {
+        ivec3 step = ivec3(i & 1, (i >> 1) & 1, i >> 2);
+        ivec3 c = first + step;
+        if (any(greaterThan(step, span)) || all(equal(c, ivec3(node_coords)))) {
+            continue;
+        }
+        uint n = find_node_gridded(uvec3(c) << (octree_depth() - level), level);
+        uint brick = n == OCTREE_NO_NODE ? OCTREE_NO_BRICK : node_bricks[n];
+        if (brick != OCTREE_NO_BRICK) {
+            s.brick = brick;
+            s.local = q - vec3(c * 2);
+            return true;
+        }
+    }
+    return false;
+}
+
+// Leaf radiance, trilinear, at a located place.
+vec4 read_leaf(BrickSample s) {
+    float edge = float(counters.leaf_pool_side * OCTREE_RADIANCE_BRICK);
+    vec3 texel = vec3(brick_origin(s.brick, counters.leaf_pool_side, OCTREE_RADIANCE_BRICK)) + 1.0 + s.local;
+    return textureLod(voxel_radiance, texel / edge, 0.0);
+}
+
+// Directional radiance d of an interior brick, trilinear, at a located place. The six
+// directions of a brick sit side by side along x, one pool width apart.
+vec4 read_interior(BrickSample s, int d) {
+    float edge = float(counters.interior_pool_side * OCTREE_RADIANCE_BRICK);
+    vec3 texel = vec3(brick_origin(s.brick, counters.interior_pool_side, OCTREE_RADIANCE_BRICK)) + 1.0 + s.local;
+    texel.x += float(d) * edge;
+    return textureLod(voxel_directional, texel / vec3(6.0 * edge, edge, edge), 0.0);
+}
+
+vec4 sample_base(vec3 uvw) {
+    BrickSample s;
+    return locate(uvw, octree_depth() - 1u, s) ? read_leaf(s) : vec4(0.0);
+}
+
+// Directional level `level` (0: voxels twice the leaves' size) is held by the interior
+// nodes at depth - 2 - level; a fractional level blends two (quadrilinear). The root's
+// bricks are the coarsest level (the dense chain goes one further, to a single voxel).
+void level_pair(float level, out uint fine, out uint coarse, out float t) {
+    float top = float(octree_depth()) - 2.0;
+    float l = clamp(level, 0.0, top);
+    float below = floor(l);
+    t = l - below;
+    fine = uint(top - below);
+    coarse = fine > 0u ? fine - 1u : 0u;
+}
+
+vec4 sample_directional(int d, vec3 uvw, float level) {
+    uint fine;
+    uint coarse;
+    float t;
+    level_pair(level, fine, coarse, t);
+    BrickSample a;
+    BrickSample b;
+    vec4 near = locate(uvw, fine, a) ? read_interior(a, d) : vec4(0.0);
+    vec4 far = (t > 0.0 && locate(uvw, coarse, b)) ? read_interior(b, d) : vec4(0.0);
+    return mix(near, far, t);
+}
+
+void sample_facing(vec3 uvw, vec3 dir, float level, out vec4 sx, out vec4 sy, out vec4 sz) {
+    uint fine;
+    uint coarse;
+    float t;
+    level_pair(level, fine, coarse, t);
+    ivec3 d = ivec3(dir.x >= 0.0 ? 0 : 1, dir.y >= 0.0 ? 2 : 3, dir.z >= 0.0 ? 4 : 5);
+    sx = vec4(0.0);
+    sy = vec4(0.0);
+    sz = vec4(0.0);
+    BrickSample s;
+    if (locate(uvw, fine, s)) {
+        sx = read_interior(s, d.x);
+        sy = read_interior(s, d.y);
+        sz = read_interior(s, d.z);
+    }
+    if (t > 0.0) {
+        vec4 cx = vec4(0.0);
+        vec4 cy = vec4(0.0);
+        vec4 cz = vec4(0.0);
+        if (locate(uvw, coarse, s)) {
+            cx = read_interior(s, d.x);
+            cy = read_interior(s, d.y);
+            cz = read_interior(s, d.z);
+        }
+        sx = mix(sx, cx, t);
+        sy = mix(sy, cy, t);
+        sz = mix(sz, cz, t);
+    }
+}
+#endif
+#endif

@@ -1,0 +1,62 @@
+// The voxels a pixel of the dilated, axis-projected triangle (gi/voxelize/triangle.glsl)
+// covers, shared by the dense voxelization and the octree's voxel-fragment list, and by
+// the rasterized (fragment shader) and the compute voxelizer. The includer defines
+// `void store_voxel(ivec3 voxel, vec3 albedo, vec3 normal, vec3 emission)` (albedo,
+// normal * 0.5 + 0.5 and emission / range, all in 0..1) before including this.
+#ifndef COVERAGE_GLSL
+#define COVERAGE_GLSL
+#include "common/scene.glsl"
+#include "common/mesh_push.glsl"
+#include "gi/vct/voxels.glsl"
+
+ivec3 unswizzle(ivec3 s, uint axis) {
+    return axis == 0u ? s.zxy : (axis == 1u ? s.yzx : s.xyz);
+}
+
+// Calls store_voxel for every voxel of the grid that the pixel centred at `pixel` covers,
+// with the triangle's `normal` and `uv` there (textures are sampled over the pixel's
+// footprint, which is the voxel's).
+void cover_pixel(vec2 pixel, vec3 normal, vec2 uv, vec4 bounds, uint axis, vec3 plane, vec2 depth_range) {
+    if (any(lessThan(pixel, bounds.xy)) || any(greaterThan(pixel, bounds.zw))) {
+        return;
+    }
+    GpuMaterial m = materials[draw.material];
+    if (material_coverage(m, uv) < CUTOUT_THRESHOLD) {
+        return;
+    }
+    vec3 albedo = material_albedo(m, uv);
+    vec3 n = normalize(normal);
+    vec3 emission = clamp(m.emission.rgb / max(vct.emission_range, 1e-6), 0.0, 1.0);
+
+    // The triangle's depth over this pixel's footprint: a slope up to 1 (dominant axis)
+    // spans up to two voxels, and every one of them is covered.
+    float center = dot(plane, vec3(pixel, 1.0));
+    float spread = 0.5 * (abs(plane.x) + abs(plane.y));
+    float z0 = max(center - spread, depth_range.x);
+    float z1 = min(center + spread, depth_range.y);
+    int first = int(floor(z0));
+    int last = int(floor(z1));
+    int res = int(vct.resolution);
+    for (int z = first; z <= last; z++) {
+        ivec3 voxel = unswizzle(ivec3(ivec2(pixel), z), axis);
+        if (any(lessThan(voxel, ivec3(0))) || any(greaterThanEqual(voxel, ivec3(res)))) {
+            continue;
+        }
+        store_voxel(voxel, albedo, n * 0.5 + 0.5, emission);
+    }
+}
+
+#ifndef MATERIAL_GRADIENTS
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) flat in vec4 in_bounds;
+layout(location = 4) flat in uint in_axis;
+layout(location = 5) flat in vec3 in_plane;
+layout(location = 6) flat in vec2 in_depth_range;
+
+// The rasterizer's fragment: its pixel of the triangle that voxelize.geom projected.
+void cover_voxels() {
+    cover_pixel(gl_FragCoord.xy, in_normal, in_uv, in_bounds, in_axis, in_plane, in_depth_range);
+}
+#endif
+#endif

@@ -1,0 +1,37 @@
+// Set 3 of the voxel cone tracer's passes: the voxel grid and the cone settings, and the
+// packed formats of the voxel attributes, shared by both voxel stores (the dense grid:
+// Präntare 2016, Villegas 2018; the octree: Dřínovský 2013).
+#ifndef VOXELS_GLSL
+#define VOXELS_GLSL
+#include "gpu_layout.glsl"
+
+layout(set = SET_GI, binding = BINDING_VCT_UNIFORMS) uniform VctBlock {
+    VctUniforms vct;
+};
+
+// RGBA8 packed as r | g << 8 | b << 16 | a << 24, channels in 0..255.
+vec4 unpack_rgba8(uint v) {
+    return vec4(float(v & 0xffu), float((v >> 8) & 0xffu), float((v >> 16) & 0xffu), float(v >> 24));
+}
+
+uint pack_rgba8(vec4 v) {
+    uvec4 u = uvec4(clamp(round(v), 0.0, 255.0));
+    return u.x | (u.y << 8) | (u.z << 16) | (u.w << 24);
+}
+
+// A packed normal (xyz * 127.5 + 127.5) as a vector of length up to 1 (shorter where
+// the averaged normals disagree); `flip_normal` negates it exactly.
+vec3 unpack_normal(uint v) {
+    return (unpack_rgba8(v).xyz * 2.0 - 255.0) / 255.0;
+}
+
+// The packed normal turned around (each of x, y, z becomes 255 minus it), its alpha kept.
+uint flip_normal(uint v) {
+    return v ^ 0x00ffffffu;
+}
+
+// World position of the centre of voxel `v`.
+vec3 voxel_center(ivec3 v) {
+    return vct.origin.xyz + (vec3(v) + 0.5) * vct.origin.w;
+}
+#endif

@@ -1,0 +1,148 @@
+//! The cone tracer's command-line options, flattened into every command's.
+
+use anyhow::Result;
+use clap::Args;
+
+use super::octree::check_depth;
+use super::voxelize::Voxelizer;
+use super::{check_voxels, ConeSettings, Store, VctSettings, DEFAULT_VOXELS};
+use crate::scene::GiOverrides;
+
+#[derive(Args, Debug, Clone)]
+pub struct VctArgs {
+    /// Voxels per axis of the dense grid, a power of two from 4 to 1024 [default: 64,
+    /// or the scene file's [gi] voxels].
+    #[arg(long)]
+    pub voxels: Option<u32>,
+    /// Levels of the sparse voxel octree (--gi octree), 6 to 10: an effective grid of
+    /// 2^depth voxels per axis [default: log2 of --voxels, so the dense default's 64³].
+    #[arg(long)]
+    pub octree_depth: Option<u32>,
+    /// Full aperture of each diffuse cone, degrees, 1 to 179 [default: 60].
+    #[arg(long)]
+    pub diffuse_aperture: Option<f32>,
+    /// Step of the cones gathering light for the pixels (diffuse, specular, refraction)
+    /// as a fraction of the cone's diameter (beta), 0.05 to 2 [default: 0.25].
+    #[arg(long)]
+    pub step_factor: Option<f32>,
+    /// Step of the voxel bounce's diffuse cones as a fraction of the cone's diameter,
+    /// 0.05 to 2 [default: 0.5].
+    #[arg(long)]
+    pub bounce_step_factor: Option<f32>,
+    /// Step of the soft-shadow cones as a fraction of the cone's diameter, 0.05 to 2
+    /// [default: 0.5].
+    #[arg(long)]
+    pub shadow_step_factor: Option<f32>,
+    /// Step the diffuse cones level by level, each sample twice as far and wide as the
+    /// last (Dřínovský's sampling of wide cones), instead of by the step factor.
+    #[arg(long)]
+    pub wide_steps_by_level: bool,
+    /// Diffuse cones per gather, 1 to 16: one along the normal, the rest in a ring at 57.5
+    /// degrees, each traced on screen as narrower sub-cones [default: 6].
+    #[arg(long)]
+    pub diffuse_cones: Option<u32>,
+    /// Trace the cones (indirect light, soft shadows, specular, refraction) on one pixel of
+    /// each NxN block and upsample, 1 to 8
+    /// [default: height / 64, 2 to 8: 4 at 256 rows, 8 at 512 and above].
+    #[arg(long)]
+    pub indirect_scale: Option<u32>,
+    /// Recompute every bounce every frame, instead of adding one bounce per frame to the
+    /// last frame's light (the first frame always computes them all).
+    #[arg(long)]
+    pub no_accumulate: bool,
+    /// Light bounces between voxels, 1 to 8 (1: direct light on the voxels only)
+    /// [default: 8].
+    #[arg(long)]
+    pub bounces: Option<u32>,
+    /// Shadow the direct light with soft-shadow cones through the voxels instead of with
+    /// shadow maps (needs --gi dense or --gi octree).
+    #[arg(long)]
+    pub shadow_cones: bool,
+    /// Full aperture of the soft-shadow cones, degrees, 0.1 to 90: the apparent size of
+    /// the lights [default: 4].
+    #[arg(long)]
+    pub shadow_aperture: Option<f32>,
+    /// Ambient occlusion: occluders this many voxels away occlude half as much, 0.1 to
+    /// 1024 [default: 4].
+    #[arg(long)]
+    pub ao_distance: Option<f32>,
+    /// Re-voxelize and re-shade the static geometry every frame too (for benchmarks);
+    /// by default static geometry is voxelized once and only moving meshes every frame.
+    #[arg(long)]
+    pub full_update: bool,
+    /// How the scene is voxelized (both cover the same voxels)
+    #[arg(long, value_enum, default_value_t)]
+    pub voxelizer: Voxelizer,
+}
+
+impl VctArgs {
+    /// The options given that only the cone tracer reads, as their flags.
+    pub fn given(&self) -> Vec<&'static str> {
+        [
+            (self.shadow_cones, "--shadow-cones"),
+            (self.full_update, "--full-update"),
+        ]
+        .into_iter()
+        .filter_map(|(set, flag)| set.then_some(flag))
+        .collect()
+    }
+
+    /// The cone tracer's settings in `store` (`octree`: the octree, else the dense grid):
+    /// the command line over the scene file's `[gi]` over the defaults.
+    pub fn settings(&self, octree: bool, scene: &GiOverrides) -> Result<VctSettings> {
+        let d = ConeSettings::default();
+        let cones = ConeSettings {
+            bounces: self.bounces.or(scene.bounces).unwrap_or(d.bounces),
+            indirect_scale: self.indirect_scale.or(scene.indirect_scale),
+            diffuse_cones: self
+                .diffuse_cones
+                .or(scene.diffuse_cones)
+                .unwrap_or(d.diffuse_cones),
+            diffuse_aperture_deg: self
+                .diffuse_aperture
+                .or(scene.diffuse_aperture_deg)
+                .unwrap_or(d.diffuse_aperture_deg),
+            step_factor: self
+                .step_factor
+                .or(scene.step_factor)
+                .unwrap_or(d.step_factor),
+            bounce_step_factor: self
+                .bounce_step_factor
+                .or(scene.bounce_step_factor)
+                .unwrap_or(d.bounce_step_factor),
+            shadow_step_factor: self
+                .shadow_step_factor
+                .or(scene.shadow_step_factor)
+                .unwrap_or(d.shadow_step_factor),
+            wide_steps_by_level: self.wide_steps_by_level
+                || scene.wide_steps_by_level.unwrap_or(d.wide_steps_by_level),
+            accumulate_bounces: !self.no_accumulate,
+            shadow_aperture_deg: self
+                .shadow_aperture
+                .or(scene.shadow_aperture_deg)
+                .unwrap_or(d.shadow_aperture_deg),
+            ao_distance_voxels: self
+                .ao_distance
+                .or(scene.ao_distance_voxels)
+                .unwrap_or(d.ao_distance_voxels),
+        };
+        cones.check()?;
+        let voxels = self.voxels.or(scene.voxels).unwrap_or(DEFAULT_VOXELS);
+        let (voxels, store) = if octree {
+            let depth = self.octree_depth.unwrap_or(voxels.trailing_zeros());
+            check_depth(depth)?;
+            (1 << depth, Store::Octree { capacities: None })
+        } else {
+            (voxels, Store::Dense)
+        };
+        check_voxels(voxels)?;
+        Ok(VctSettings {
+            voxels,
+            store,
+            cones,
+            shadow_cones: self.shadow_cones || scene.shadow_cones.unwrap_or(false),
+            full_update: self.full_update,
+            voxelizer: self.voxelizer,
+        })
+    }
+}

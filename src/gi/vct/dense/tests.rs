@@ -1,0 +1,299 @@
+//! The dense GI stages against their CPU twins (`reference.rs`), on the real device with
+//! validation on.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use super::super::reference;
+use super::super::voxelize::Voxelizer;
+use super::super::{Grid, Store};
+use super::Volume;
+use crate::renderer::Renderer;
+use crate::scene::testing::shared_file;
+use crate::scene::{LoadOptions, Scene};
+use crate::testing::{dense, gi_settings, moving_cube_scene, render_frames, with_voxelizer};
+use crate::vk::Context;
+
+/// Renders 64x64 frames of `scene` with `--gi dense --voxels n`, one at each time,
+/// re-voxelizing the static meshes every frame with `full_update`.
+fn render_at(scene: Scene, n: u32, times: &[f32], full_update: bool) -> (Arc<Context>, Renderer) {
+    let settings = gi_settings(n, Store::Dense, full_update);
+    render_frames(scene, settings, times)
+}
+
+/// Renders one 64x64 frame of `scene` at time 0 with `--gi dense --voxels n`.
+fn render(scene: Scene, n: u32) -> (Arc<Context>, Renderer) {
+    render_at(scene, n, &[0.0], false)
+}
+
+fn occupancy(renderer: &Renderer) -> Vec<bool> {
+    let bytes = dense(renderer).store().download(Volume::Albedo, 0).unwrap();
+    bytes.chunks_exact(4).map(|t| t[3] > 0).collect()
+}
+
+/// Every voxel a triangle touches is occupied on the GPU, and the GPU's conservative
+/// coverage adds none farther than one voxel from a triangle, with either voxelizer.
+fn check_voxelization(scene: Scene, n: u32) {
+    for voxelizer in [Voxelizer::Raster, Voxelizer::Compute] {
+        check_voxelization_by(scene.clone(), n, voxelizer);
+    }
+}
+
+fn check_voxelization_by(scene: Scene, n: u32, voxelizer: Voxelizer) {
+    let triangles = reference::world_triangles(&scene);
+    let settings = with_voxelizer(gi_settings(n, Store::Dense, false), voxelizer);
+    let (ctx, renderer) = render_frames(scene, settings, &[0.0]);
+    let grid: Grid = *dense(&renderer).grid();
+    let gpu = occupancy(&renderer);
+    let exact = reference::voxelize(&triangles, &grid);
+    let near = reference::within_one_voxel(&triangles, &grid);
+    let missing = exact.iter().zip(&gpu).filter(|(c, g)| **c && !**g).count();
+    let extra = near.iter().zip(&gpu).filter(|(c, g)| !**c && **g).count();
+    let cpu_count = exact.iter().filter(|c| **c).count();
+    let gpu_count = gpu.iter().filter(|g| **g).count();
+    eprintln!(
+        "{n}^3, {voxelizer:?}: CPU {cpu_count} voxels, GPU {gpu_count}, missing {missing}, \
+         too far {extra}"
+    );
+    assert!(cpu_count > 0);
+    assert_eq!(missing, 0, "voxels the CPU marks but the GPU does not");
+    assert_eq!(
+        extra, 0,
+        "GPU voxels farther than one voxel from every triangle"
+    );
+    assert_eq!(ctx.validation_messages(), 0);
+}
+
+#[test]
+fn voxelization_matches_cpu_on_cornell_box() {
+    let Some(path) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
+        return;
+    };
+    for n in [32, 64] {
+        check_voxelization(Scene::load(&path, &LoadOptions::default()).unwrap(), n);
+    }
+}
+
+#[test]
+fn voxelization_matches_cpu_on_a_rotated_thin_mesh() {
+    let dir = std::env::temp_dir().join(format!("voxcone-thin-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A 2 x 0.02 x 1.3 slab, thinner than a voxel, tilted on all three axes, inside a
+    // unit box that sets the grid's extent.
+    let obj = "v -1 -0.01 -0.65\nv 1 -0.01 -0.65\nv 1 0.01 -0.65\nv -1 0.01 -0.65\n\
+               v -1 -0.01 0.65\nv 1 -0.01 0.65\nv 1 0.01 0.65\nv -1 0.01 0.65\n\
+               f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n";
+    std::fs::write(dir.join("slab.obj"), obj).unwrap();
+    std::fs::write(
+        dir.join("scene.toml"),
+        "[[mesh]]\npath = \"slab.obj\"\nrotate_deg = [23, 41, 17]\n",
+    )
+    .unwrap();
+    let scene = Scene::load(&dir.join("scene.toml"), &LoadOptions::default()).unwrap();
+    for n in [32, 64] {
+        check_voxelization(scene.clone(), n);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+fn halves(bytes: &[u8]) -> Vec<[f32; 4]> {
+    bytes
+        .chunks_exact(8)
+        .map(|t| {
+            let h = |i: usize| half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32();
+            [h(0), h(1), h(2), h(3)]
+        })
+        .collect()
+}
+
+/// Each level of each directional volume equals the CPU filter applied to the level
+/// below as downloaded (the first level: the base radiance, weighted by which way each
+/// voxel's lit face looks), within half-float rounding.
+#[test]
+fn filter_matches_cpu() {
+    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+        return;
+    };
+    let options = LoadOptions::REFERENCE;
+    let n = 32;
+    let (ctx, renderer) = render(Scene::load(&path, &options).unwrap(), n);
+    let gi = dense(&renderer).store();
+    let base = halves(&gi.download(Volume::Radiance, 0).unwrap());
+    let normals: Vec<Vec3> = gi
+        .download(Volume::Normal, 0)
+        .unwrap()
+        .chunks_exact(4)
+        .map(|t| Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 127.5 - 1.0)
+        .collect();
+    let mut worst = 0.0f32;
+    for d in 0..6 {
+        let mut below: Vec<[f32; 4]> = base
+            .iter()
+            .zip(&normals)
+            .map(|(v, n)| v.map(|c| c * reference::facing_weight(*n, d)))
+            .collect();
+        let mut size = n;
+        // n/2 down to 2.
+        for level in 0..n.trailing_zeros() - 1 {
+            let cpu = reference::filter_directional(&below, size, d);
+            let gpu = halves(&gi.download(Volume::Directional(d), level).unwrap());
+            for (c, g) in cpu.iter().zip(&gpu) {
+                for k in 0..4 {
+                    let err = (c[k] - g[k]).abs() / c[k].abs().max(1.0);
+                    worst = worst.max(err);
+                    assert!(
+                        err <= 2.0 / 1024.0,
+                        "direction {d} level {level}: CPU {c:?} GPU {g:?}"
+                    );
+                }
+            }
+            below = gpu;
+            size /= 2;
+        }
+    }
+    eprintln!("filter: worst relative difference {worst:.2e}");
+    assert!(base.iter().any(|v| v[3] > 0.0), "empty radiance volume");
+    assert_eq!(ctx.validation_messages(), 0);
+}
+
+/// A mesh moving across the Cornell box leaves no voxel behind: after frames at several
+/// times, with the static voxels kept from the first frame, the voxels (occupancy and
+/// albedo) equal a fresh voxelization at the last time and a full re-voxelization of
+/// every frame, with either voxelizer.
+#[test]
+fn moving_mesh_leaves_no_voxels_behind() {
+    let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("voxcone-moving-{}", std::process::id()));
+    let scene = moving_cube_scene(&cornell, &dir, false);
+    for voxelizer in [Voxelizer::Raster, Voxelizer::Compute] {
+        check_moving_mesh(scene.clone(), voxelizer);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+fn check_moving_mesh(scene: Scene, voxelizer: Voxelizer) {
+    let render_at = |scene: Scene, times: &[f32], full_update| {
+        let settings = gi_settings(32, Store::Dense, full_update);
+        render_frames(scene, with_voxelizer(settings, voxelizer), times)
+    };
+    let times = [0.0, 0.5, 1.0];
+    let (ctx, moved) = render_at(scene.clone(), &times, false);
+    let moved_voxels = occupancy(&moved);
+    let (_, fresh) = render_at(scene.clone(), &[1.0], false);
+    let fresh_voxels = occupancy(&fresh);
+    let (_, full) = render_at(scene.clone(), &times, true);
+    let (_, start) = render_at(scene, &[0.0], false);
+    let start_voxels = occupancy(&start);
+    assert_ne!(start_voxels, fresh_voxels, "the cube did not move");
+    assert_eq!(
+        moved_voxels, fresh_voxels,
+        "voxels left behind or missing after the move"
+    );
+    let albedo = |r: &Renderer| dense(r).store().download(Volume::Albedo, 0).unwrap();
+    assert!(
+        albedo(&moved) == albedo(&fresh),
+        "albedo differs from a fresh voxelization"
+    );
+    assert!(
+        albedo(&moved) == albedo(&full),
+        "albedo differs from --full-update"
+    );
+    assert_eq!(ctx.validation_messages(), 0);
+}
+
+/// Static geometry is voxelized once: later frames only shade it (a moving light needs
+/// no voxelization), unless every frame is a full update.
+#[test]
+fn static_voxels_are_voxelized_once() {
+    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+        return;
+    };
+    let scene = Scene::load(&path, &LoadOptions::default()).unwrap();
+    let passes = |full_update| {
+        let (ctx, renderer) = render_at(scene.clone(), 32, &[0.0, 0.5], full_update);
+        assert_eq!(ctx.validation_messages(), 0);
+        renderer
+            .timings
+            .iter()
+            .map(|(name, _)| name.clone())
+            .collect::<Vec<_>>()
+    };
+    let kept = passes(false);
+    assert!(!kept.iter().any(|p| p == "voxelize"), "{kept:?}");
+    assert!(kept.iter().any(|p| p == "inject"), "{kept:?}");
+    let full = passes(true);
+    assert!(full.iter().any(|p| p == "voxelize"), "{full:?}");
+}
+
+/// The voxels' albedo, normal and emission do not depend on the order in which the
+/// fragments arrive: the same triangles drawn in the opposite order (meshes and the
+/// triangles within each) give bit-identical volumes. A running RGBA8 average rounds
+/// differently in each order.
+#[test]
+fn voxel_means_do_not_depend_on_fragment_order() {
+    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+        return;
+    };
+    let scene = Scene::load(&path, &LoadOptions::default()).unwrap();
+    let mut reversed = scene.clone();
+    reversed.meshes.reverse();
+    for mesh in &mut reversed.meshes {
+        let triangles: Vec<[u32; 3]> = mesh
+            .indices
+            .chunks_exact(3)
+            .rev()
+            .map(|t| [t[0], t[1], t[2]])
+            .collect();
+        mesh.indices = triangles.concat();
+    }
+    let volumes = |scene: Scene| {
+        let (ctx, renderer) = render(scene, 64);
+        assert_eq!(ctx.validation_messages(), 0);
+        let gi = dense(&renderer).store();
+        [Volume::Albedo, Volume::Normal, Volume::Emission].map(|v| gi.download(v, 0).unwrap())
+    };
+    let (first, second) = (volumes(scene), volumes(reversed));
+    for (name, (a, b)) in ["albedo", "normal", "emission"]
+        .iter()
+        .zip(first.iter().zip(&second))
+    {
+        let occupied = a.chunks_exact(4).filter(|t| t[3] > 0).count();
+        let differ = a
+            .chunks_exact(4)
+            .zip(b.chunks_exact(4))
+            .filter(|(x, y)| x != y)
+            .count();
+        eprintln!("{name}: {differ} of {occupied} occupied voxels differ");
+        assert!(occupied > 0);
+        assert_eq!(differ, 0, "voxel {name} depends on the fragments' order");
+    }
+}
+
+/// The occupied-voxel list that the bounces run over holds each occupied voxel once and
+/// nothing else, and its dispatch covers it (synchronization validation cannot see
+/// storage-buffer hazards, so the buffer passes are checked by their result).
+#[test]
+fn voxel_list_holds_exactly_the_occupied_voxels() {
+    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
+        return;
+    };
+    let scene = Scene::load(&path, &LoadOptions::default()).unwrap();
+    let n = 32;
+    let (ctx, renderer) = render_at(scene, n, &[0.0, 0.5], true);
+    let gi = dense(&renderer).store();
+    let occupied = occupancy(&renderer);
+    let mut listed = vec![false; occupied.len()];
+    for [x, y, z] in gi.download_voxel_list().unwrap() {
+        let i = gi.grid.index(x, y, z);
+        assert!(!listed[i], "voxel ({x}, {y}, {z}) listed twice");
+        listed[i] = true;
+    }
+    let count = occupied.iter().filter(|&&o| o).count();
+    eprintln!("voxel list: {count} occupied voxels");
+    assert!(count > 0);
+    assert_eq!(listed, occupied);
+    assert_eq!(ctx.validation_messages(), 0);
+}

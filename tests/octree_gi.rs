@@ -1,0 +1,140 @@
+//! `--gi octree` against `--gi dense` and the path-traced ground truth; every render runs with
+//! validation and fails on any message.
+
+mod common;
+
+use std::path::Path;
+
+use common::{render_256 as render, shared, stderr, temp_dir, voxcone};
+use voxcone::compare::{compare, CompareOptions};
+use voxcone::imageio::load_rgb;
+
+fn flip(reference: &Path, test: &Path) -> f32 {
+    compare(reference, test, &CompareOptions::default())
+        .unwrap()
+        .flip_ldr
+}
+
+/// The octree at depth 6 and the dense grid at 64³ give the same picture of the Cornell
+/// box, and the octree's is at least as close to the path-traced one.
+#[test]
+fn octree_agrees_with_dense_grid() {
+    let Some(shared) = shared() else { return };
+    let reference = shared.join("reference/cornell_point.exr");
+    let scene = shared.join("reference/cornell_point.scene.json");
+    let dir = temp_dir("octree_gi");
+    let (octree, dense) = (dir.join("octree.exr"), dir.join("dense.exr"));
+    render(&scene, &["--gi", "octree", "--octree-depth", "6"], &octree);
+    render(&scene, &["--gi", "dense", "--voxels", "64"], &dense);
+    let between = flip(&dense, &octree);
+    let (flip_octree, flip_dense) = (flip(&reference, &octree), flip(&reference, &dense));
+    eprintln!(
+        "LDR-FLIP octree vs dense {between:.6}; against cornell_point: octree {flip_octree:.7}, \
+         dense {flip_dense:.7}"
+    );
+    // Measured 1.7e-5 to 2.1e-5, and 0.1325243-0.1325253 against 0.1325251: both average the same
+    // exact fragment sums, and the frame after the octree's build stores its radiance
+    // exactly, as the dense grid does. (0.0019 while the dense grid kept a running RGBA8
+    // average and the octree stored only changes beyond 1/512; the issue asks for 0.03.)
+    // What is left is the sampler's rounding where the bricks land (see below).
+    assert!(
+        between <= 0.0005,
+        "octree and dense differ: LDR-FLIP {between}"
+    );
+    assert!(
+        flip_octree <= flip_dense + 1e-5,
+        "octree {flip_octree} worse than dense {flip_dense}"
+    );
+}
+
+/// Two renders of the same static frame agree. The voxels' values do not depend on the
+/// order of the GPU's atomic operations (integer sums), but where a brick lands in its
+/// pool does, and the sampler's fixed-point texel coordinates then round differently: a
+/// few pixels differ by a few parts in ten thousand (measured: 140 of 65,536 pixels, at
+/// most 4.2e-4 of the pixel's value).
+#[test]
+fn octree_renders_are_deterministic() {
+    let Some(shared) = shared() else { return };
+    let scene = shared.join("reference/cornell_point.scene.json");
+    let dir = temp_dir("octree_determinism");
+    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+    render(&scene, &["--gi", "octree"], &a);
+    render(&scene, &["--gi", "octree"], &b);
+    let (a, b) = (load_rgb(&a).unwrap().0.data, load_rgb(&b).unwrap().0.data);
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs() / x.abs().max(1e-3))
+        .fold(0.0f32, f32::max);
+    let differing = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+    eprintln!(
+        "{differing} of {} values differ, by at most {worst:.2e} relative",
+        a.len()
+    );
+    assert!(worst <= 2e-3, "renders differ by {worst} relative");
+}
+
+/// Settings the octree cannot take are refused with the reason, before any GPU work
+/// (`svo`, the technique's old name, still selects it).
+#[test]
+fn octree_settings_are_checked() {
+    let dir = temp_dir("octree_settings");
+    let out = dir.join("x.png");
+    let out = out.to_str().unwrap();
+    let cases: [(&[&str], &str); 3] = [
+        (&["--gi", "svo", "--octree-depth", "5"], "between 6 and 10"),
+        (
+            &["--gi", "dense", "--octree-depth", "7"],
+            "needs --gi octree",
+        ),
+        (
+            &["--gi", "dense", "--debug-view", "octree-nodes"],
+            "needs --gi octree",
+        ),
+    ];
+    for (extra, expected) in cases {
+        let mut args = vec!["render", "-o", out];
+        args.extend_from_slice(extra);
+        let output = voxcone(&args);
+        assert!(!output.status.success(), "{extra:?} was accepted");
+        let err = stderr(&output);
+        assert!(err.contains(expected), "{extra:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+/// The octree debug view draws occupied nodes: on the Cornell box at level 2 (nodes of
+/// 8^3 voxels) most of the image is covered, in more than a few colours.
+#[test]
+fn octree_node_view_draws_nodes() {
+    let dir = temp_dir("octree_nodes");
+    let out = dir.join("nodes.png");
+    render(
+        &voxcone::cli::default_scene(),
+        &[
+            "--gi",
+            "octree",
+            "--debug-view",
+            "octree-nodes",
+            "--debug-level",
+            "2",
+        ],
+        &out,
+    );
+    let (image, _) = load_rgb(&out).unwrap();
+    let pixels: Vec<[u8; 3]> = image
+        .data
+        .chunks_exact(3)
+        .map(|p| [p[0], p[1], p[2]].map(|c| (c * 255.0).round() as u8))
+        .collect();
+    let covered = pixels.iter().filter(|p| **p != [0, 0, 0]).count();
+    let colours: std::collections::HashSet<_> = pixels.iter().collect();
+    eprintln!(
+        "{} of {} pixels covered, {} colours",
+        covered,
+        pixels.len(),
+        colours.len()
+    );
+    assert!(covered > pixels.len() * 3 / 4);
+    assert!(colours.len() > 50);
+}
