@@ -250,6 +250,62 @@ gpu_layout! {
         /// `FrameUniforms.debug_view`: the octree's occupied nodes at depth `debug_level` below the leaves, edges drawn (`--gi svo`).
         DEBUG_OCTREE_NODES = 6;
 
+        /// Scene ray casting (the first bindings of a set 3 that casts rays,
+        /// `glsl/ray/rays.glsl`): `RayUniforms` uniform buffer.
+        BINDING_RAY_UNIFORMS = 0;
+        /// Ray casting (set 3): the BVHs' nodes, `BvhNode[]` storage buffer: the static
+        /// meshes' BVH from node 0, the moving meshes' after it (`RayUniforms.moving_root`).
+        BINDING_RAY_NODES = 1;
+        /// Ray casting (set 3): the triangles in the BVHs' leaf order, `RayTriangle[]` storage
+        /// buffer: a vertex, two edges and the material, as the intersection test reads them.
+        BINDING_RAY_TRIANGLES = 2;
+        /// Ray casting (set 3): the triangles' shading attributes, `RayShading[]` storage
+        /// buffer, in the same order.
+        BINDING_RAY_SHADING = 3;
+        /// Ray casting (set 3): the scene's materials, `GpuMaterial[]` storage buffer.
+        BINDING_RAY_MATERIALS = 4;
+        /// Ray casting (set 3): every scene texture's full-resolution level in one atlas,
+        /// `sampler2D` read with `texelFetch` (filtered in the shader: dynamic indexing of
+        /// texture arrays is an optional feature that lavapipe lacks); albedo sRGB-encoded.
+        BINDING_RAY_ATLAS = 5;
+        /// Ray casting (set 3): where each texture lies in the atlas, `uvec4[]` storage buffer
+        /// (x, y, width, height in texels).
+        BINDING_RAY_TEXTURES = 6;
+        /// Ray casting (set 3): the emissive triangles for next-event estimation, `RayEmitter[]`
+        /// storage buffer, sampled by power through their cumulative distribution.
+        BINDING_RAY_EMITTERS = 7;
+        /// A BVH node index meaning "none" (`RayUniforms.moving_root` without moving meshes),
+        /// and a triangle index meaning "no hit".
+        RAY_NONE = 0xFFFFFFFF;
+        /// `RayTriangle.e2.w` bit: the material is cut out (`RayShading` then holds the uvs its
+        /// coverage is looked up at).
+        RAY_CUT_OUT = 1;
+        /// `RayTriangle.e2.w` bit: a moving mesh's (not among the emitters next-event
+        /// estimation samples).
+        RAY_MOVING = 2;
+        /// Entries of the traversal stack (a BVH of 2^24 triangles is about 30 levels deep).
+        RAY_STACK_SIZE = 48;
+        /// Workgroup size of the batched ray queries.
+        RAY_GROUP_SIZE = 64;
+        /// `RayQuery.kind`: the closest hit.
+        RAY_CLOSEST = 0;
+        /// `RayQuery.kind`: any hit (visibility).
+        RAY_ANY = 1;
+
+        /// Batched ray queries (set 3, after the ray-casting bindings): `RayQuery[]` storage buffer.
+        BINDING_QUERY_RAYS = 8;
+        /// Batched ray queries (set 3): `RayHit[]` storage buffer, one per query.
+        BINDING_QUERY_HITS = 9;
+
+        /// Path tracer (set 3, after the ray-casting bindings): `PathUniforms` uniform buffer.
+        BINDING_PATH_UNIFORMS = 8;
+        /// Path tracer (set 3): the sum of the samples so far (rgb) and their count (a) per
+        /// pixel, `rgba32f` storage image.
+        BINDING_PATH_SUM = 9;
+        /// Path tracer (set 3): rays cast since the counter was cleared, `uint[]` storage buffer
+        /// (one word).
+        BINDING_PATH_RAYS = 10;
+
     }
 
     /// Per-frame constants.
@@ -540,6 +596,116 @@ gpu_layout! {
         ivec4 region_min,
         /// `mark.comp`: the last voxel (xyz) of that region (below `region_min`: none).
         ivec4 region_max,
+    }
+
+    /// A node of a BVH2 over triangles (obvhs's layout): an inner node's children are nodes `first` and `first + 1`; a leaf's triangles are `first` to `first + count - 1`.
+    struct BvhNode {
+        /// xyz bounds' minimum, w `first` (the bits of a uint).
+        vec4 min_first,
+        /// xyz bounds' maximum, w `count` (the bits of a uint): 0 for an inner node.
+        vec4 max_count,
+    }
+
+    /// A triangle as the intersection test reads it.
+    struct RayTriangle {
+        /// xyz the first vertex (world space), w its material (the bits of a uint).
+        vec4 v0,
+        /// xyz the second vertex minus the first, w the triangle's index in the scene (meshes in order, triangles in index order; the bits of a uint).
+        vec4 e1,
+        /// xyz the third vertex minus the first, w `RAY_CUT_OUT` and `RAY_MOVING` bits (the bits of a uint).
+        vec4 e2,
+    }
+
+    /// A triangle's shading attributes: its vertices' normals (world space) and uvs.
+    struct RayShading {
+        /// xyz the first vertex's normal, w its u.
+        vec4 n0,
+        /// xyz the second vertex's normal, w its v.
+        vec4 n1,
+        /// xyz the third vertex's normal, w the second vertex's u.
+        vec4 n2,
+        /// The second vertex's v, the third vertex's u and v; w unused.
+        vec4 uv,
+    }
+
+    /// An emissive triangle for next-event estimation.
+    struct RayEmitter {
+        /// The triangle (an index into `BINDING_RAY_TRIANGLES`).
+        uint triangle,
+        /// The cumulative distribution up to and including this emitter: power over the total power (the last is 1).
+        float cdf,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+    }
+
+    /// What every ray cast needs beyond the buffers.
+    struct RayUniforms {
+        /// The static meshes' BVH's root: node 0, or `RAY_NONE` when every mesh moves.
+        uint static_root,
+        /// The moving meshes' BVH's root, after the static meshes' nodes, or `RAY_NONE` without moving meshes.
+        uint moving_root,
+        /// Entries of `BINDING_RAY_EMITTERS`.
+        uint emitter_count,
+        /// The emitters' total power (sum of area x largest emitted radiance).
+        float emitter_power,
+        /// World distance rays start from their surface: a small fraction of the scene's size.
+        float epsilon,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+        /// Unused.
+        uint pad2,
+    }
+
+    /// One batched ray query.
+    struct RayQuery {
+        /// xyz origin, w the smallest distance counted.
+        vec4 origin_tmin,
+        /// xyz direction (unit length), w the largest distance counted.
+        vec4 direction_tmax,
+        /// `RAY_CLOSEST` or `RAY_ANY`.
+        uint kind,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+        /// Unused.
+        uint pad2,
+    }
+
+    /// A batched query's answer.
+    struct RayHit {
+        /// The triangle hit (its index in the scene, `RayTriangle.e1.w`), `RAY_NONE` for none; for `RAY_ANY`, 0 where something was hit.
+        uint triangle,
+        /// Distance along the ray.
+        float t,
+        /// Barycentric coordinate of the second vertex.
+        float u,
+        /// Barycentric coordinate of the third vertex.
+        float v,
+    }
+
+    /// The path tracer's settings and progress.
+    struct PathUniforms {
+        /// Samples already in `BINDING_PATH_SUM`: 0 starts the sum afresh.
+        uint samples_done,
+        /// Samples each pixel takes in this dispatch.
+        uint samples_now,
+        /// Longest path in vertices counted from the camera (Mitsuba's `max_depth`: 2 is direct light only); 0 for no limit.
+        uint max_depth,
+        /// Russian roulette starts at this depth.
+        uint rr_depth,
+        /// The random sequence's seed.
+        uint seed,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+        /// Unused.
+        uint pad2,
     }
 
     /// Push constants of every mesh draw.

@@ -365,7 +365,7 @@ fn longest_edge(mesh: &crate::scene::Mesh) -> f32 {
         .fold(0.0, f32::max)
 }
 
-fn upload_texture(
+pub(crate) fn upload_texture(
     ctx: &Arc<Context>,
     one_shot: &OneShot,
     name: &str,

@@ -1,0 +1,420 @@
+//! Scene ray casting, for any pass that casts rays against the scene's triangles
+//! (`glsl/ray/rays.glsl`): the closest hit (triangle, barycentrics, material, normal) and
+//! any hit (visibility), through the first bindings of its set 3 (`BINDING_RAY_*`).
+//!
+//! Two BVH2s: the static meshes', built once, and the moving meshes', built again every
+//! frame at the frame's time (a rebuild over their triangles alone: they are few; a refit
+//! would keep a tree built for other positions). The nodes and triangles of both sit in
+//! the same buffers, the moving meshes' after the static ones', rewritten in the frame's
+//! command buffer from a staging buffer per frame in flight.
+
+mod atlas;
+mod bvh;
+pub mod query;
+#[cfg(test)]
+mod tests;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{bail, Result};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+use crate::gpu_layout::{
+    self as layout, BvhNode, RayEmitter, RayShading, RayTriangle, RayUniforms, RAY_NONE,
+};
+use crate::scene::Scene;
+use crate::scene_gpu::upload_texture;
+use crate::vk::{
+    memory_barrier, sampler_info, upload_buffer, Binding, Buffer, Context, Image, OneShot, Sampler,
+    SetWriter,
+};
+pub use bvh::{Bvh, Triangles};
+
+/// What building the static BVH took and made, for `bench` and the logs.
+#[derive(Clone, Debug)]
+pub struct BuildStats {
+    pub triangles: usize,
+    pub nodes: usize,
+    /// Host time of the static build, triangles gathered and flattened included.
+    pub build_ms: f64,
+    /// The longest path from the root to a leaf.
+    pub depth: u32,
+}
+
+/// The scene's triangles on the GPU, ready to cast rays against.
+pub struct SceneRays {
+    uniforms: Buffer,
+    nodes: Buffer,
+    triangles: Buffer,
+    shading: Buffer,
+    emitters: Buffer,
+    textures: Buffer,
+    atlas: Image,
+    /// Referenced by the sets the rays are written into.
+    atlas_sampler: Sampler,
+    /// Nodes and triangles of the static part (the moving meshes' follow).
+    static_nodes: u32,
+    static_triangles: u32,
+    /// The moving meshes' triangles (0 without moving meshes).
+    moving_triangles: u32,
+    /// Per frame in flight: the moving meshes' nodes, triangles, shading and uniforms to
+    /// copy in.
+    staging: Vec<Buffer>,
+    pub stats: BuildStats,
+    ctx: Arc<Context>,
+}
+
+/// The stages that cast rays.
+const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::COMPUTE;
+
+/// The deepest BVH whose traversal the stack holds.
+fn check_depth(depth: u32, what: &str) -> Result<()> {
+    if depth >= layout::RAY_STACK_SIZE {
+        bail!(
+            "the {what} BVH is {depth} levels deep, more than the {} its traversal stack holds",
+            layout::RAY_STACK_SIZE
+        );
+    }
+    Ok(())
+}
+
+impl SceneRays {
+    /// The set-3 bindings every ray-casting pass starts with.
+    pub fn bindings() -> Vec<Binding> {
+        let storage = vk::DescriptorType::STORAGE_BUFFER;
+        vec![
+            Binding::new(
+                layout::BINDING_RAY_UNIFORMS,
+                vk::DescriptorType::UNIFORM_BUFFER,
+                STAGES,
+            ),
+            Binding::new(layout::BINDING_RAY_NODES, storage, STAGES),
+            Binding::new(layout::BINDING_RAY_TRIANGLES, storage, STAGES),
+            Binding::new(layout::BINDING_RAY_SHADING, storage, STAGES),
+            Binding::new(layout::BINDING_RAY_MATERIALS, storage, STAGES),
+            Binding::new(
+                layout::BINDING_RAY_ATLAS,
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                STAGES,
+            ),
+            Binding::new(layout::BINDING_RAY_TEXTURES, storage, STAGES),
+            Binding::new(layout::BINDING_RAY_EMITTERS, storage, STAGES),
+        ]
+    }
+
+    /// Builds the static meshes' BVH, uploads it, the texture atlas and the emitters, and
+    /// makes room for the moving meshes' (at time 0 until the first frame's update).
+    /// `frames_in_flight` frames may be recorded before the first is done.
+    pub fn new(ctx: &Arc<Context>, scene: &Scene, frames_in_flight: usize) -> Result<Self> {
+        let start = Instant::now();
+        let statics = Triangles::of(scene, 0.0, |m| m.animation.is_none());
+        let built = Bvh::build(&statics, 0, 0, false);
+        let depth = built.depth;
+        check_depth(depth, "static meshes'")?;
+        let stats = BuildStats {
+            triangles: statics.len(),
+            nodes: built.nodes.len(),
+            build_ms: start.elapsed().as_secs_f64() * 1e3,
+            depth,
+        };
+        log::info!(
+            "ray casting: BVH of {} static triangles, {} nodes, {depth} levels, built in {:.0} ms",
+            stats.triangles,
+            stats.nodes,
+            stats.build_ms
+        );
+        let moving = Triangles::of(scene, 0.0, |m| m.animation.is_some());
+        let static_nodes = built.nodes.len() as u32;
+        let static_triangles = built.triangles.len() as u32;
+        let moving_triangles = moving.len() as u32;
+        // A BVH2 of n leaves has 2n - 1 nodes, and leaves hold a triangle or more.
+        let node_capacity = static_nodes + (2 * moving_triangles).max(1);
+        let triangle_capacity = (static_triangles + moving_triangles).max(1);
+        let one_shot = OneShot::new(ctx)?;
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+        let sized = |name: &str, element: usize, count: u32, data: &[u8]| -> Result<Buffer> {
+            let size = (element as u64 * u64::from(count)).max(16);
+            let limit = u64::from(ctx.properties.limits.max_storage_buffer_range);
+            if size > limit {
+                bail!(
+                    "the scene's {name} need {size} bytes, more than the {limit} the device binds \
+                     in one storage buffer"
+                );
+            }
+            let mut bytes = data.to_vec();
+            bytes.resize(size as usize, 0);
+            upload_buffer(ctx, &one_shot, name, &bytes, usage)
+        };
+        let nodes = sized(
+            "ray BVH nodes",
+            std::mem::size_of::<BvhNode>(),
+            node_capacity,
+            bytemuck::cast_slice(&built.nodes),
+        )?;
+        let triangles = sized(
+            "ray triangles",
+            std::mem::size_of::<RayTriangle>(),
+            triangle_capacity,
+            bytemuck::cast_slice(&built.triangles),
+        )?;
+        let shading = sized(
+            "ray triangle shading",
+            std::mem::size_of::<RayShading>(),
+            triangle_capacity,
+            bytemuck::cast_slice(&built.shading),
+        )?;
+        let (emitters, emitter_power) = emitters(scene, &built);
+        let emitter_count = emitters.len() as u32;
+        let emitters = sized(
+            "ray emitters",
+            std::mem::size_of::<RayEmitter>(),
+            emitter_count.max(1),
+            bytemuck::cast_slice(&emitters),
+        )?;
+        let max_side = ctx.properties.limits.max_image_dimension2_d;
+        let packed = atlas::pack(&scene.textures, max_side)?;
+        let texels = atlas::texels(&scene.textures, &packed);
+        let atlas = upload_texture(
+            ctx,
+            &one_shot,
+            "ray texture atlas",
+            vk::Format::R8G8B8A8_UNORM,
+            packed.width,
+            packed.height,
+            &[texels],
+        )?;
+        let rects: Vec<[u32; 4]> = if packed.rects.is_empty() {
+            vec![[0; 4]]
+        } else {
+            packed.rects
+        };
+        let textures = upload_buffer(
+            ctx,
+            &one_shot,
+            "ray texture rects",
+            bytemuck::cast_slice(&rects),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        let bounds = scene.swept_bounds();
+        let uniforms = RayUniforms {
+            static_root: built.root(0),
+            moving_root: RAY_NONE,
+            emitter_count,
+            emitter_power,
+            // Large enough to clear the float error of positions across the scene, small
+            // enough to miss no contact: 1e-5 of its size.
+            epsilon: 1e-5 * (bounds.max - bounds.min).length().max(1e-6),
+            ..Default::default()
+        };
+        let uniforms = Buffer::with_data(
+            ctx,
+            "ray uniforms",
+            bytemuck::bytes_of(&uniforms),
+            vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+        )?;
+        let staging_bytes = Self::moving_bytes(moving_triangles) as u64;
+        let staging = (0..frames_in_flight)
+            .map(|i| {
+                Buffer::new(
+                    ctx,
+                    &format!("ray moving meshes {i}"),
+                    staging_bytes.max(16),
+                    vk::BufferUsageFlags::TRANSFER_SRC,
+                    MemoryLocation::CpuToGpu,
+                )
+            })
+            .collect::<Result<_>>()?;
+        let atlas_sampler = Sampler::new(
+            ctx,
+            "ray texture atlas",
+            &sampler_info(vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE),
+        )?;
+        Ok(Self {
+            uniforms,
+            nodes,
+            triangles,
+            shading,
+            emitters,
+            textures,
+            atlas,
+            atlas_sampler,
+            static_nodes,
+            static_triangles,
+            moving_triangles,
+            staging,
+            stats,
+            ctx: ctx.clone(),
+        })
+    }
+
+    /// Bytes the moving meshes' part takes in a staging buffer: nodes, triangles, shading.
+    fn moving_bytes(moving_triangles: u32) -> usize {
+        let n = moving_triangles as usize;
+        2 * n * std::mem::size_of::<BvhNode>()
+            + n * (std::mem::size_of::<RayTriangle>() + std::mem::size_of::<RayShading>())
+    }
+
+    /// Writes the ray-casting bindings into `set`; `materials` is the scene's material
+    /// buffer.
+    pub fn write_set(&self, set: vk::DescriptorSet, materials: &Buffer) {
+        let storage = vk::DescriptorType::STORAGE_BUFFER;
+        SetWriter::new(&self.ctx, set)
+            .buffer(
+                layout::BINDING_RAY_UNIFORMS,
+                vk::DescriptorType::UNIFORM_BUFFER,
+                self.uniforms.raw,
+            )
+            .buffer(layout::BINDING_RAY_NODES, storage, self.nodes.raw)
+            .buffer(layout::BINDING_RAY_TRIANGLES, storage, self.triangles.raw)
+            .buffer(layout::BINDING_RAY_SHADING, storage, self.shading.raw)
+            .buffer(layout::BINDING_RAY_MATERIALS, storage, materials.raw)
+            .sampled_image(
+                layout::BINDING_RAY_ATLAS,
+                self.atlas.view,
+                self.atlas_sampler.raw,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            )
+            .buffer(layout::BINDING_RAY_TEXTURES, storage, self.textures.raw)
+            .buffer(layout::BINDING_RAY_EMITTERS, storage, self.emitters.raw)
+            .apply();
+    }
+
+    /// Whether the scene has moving meshes, whose BVH [`Self::record_moving`] rebuilds.
+    pub fn has_moving_meshes(&self) -> bool {
+        self.moving_triangles > 0
+    }
+
+    /// Rebuilds the moving meshes' BVH at scene time `time_s` and records its copy into
+    /// the buffers, for the ray casts recorded after it in `cmd`; `slot` is the frame's
+    /// slot in flight (its staging buffer is free again).
+    pub fn record_moving(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        scene: &Scene,
+        time_s: f32,
+        slot: usize,
+    ) -> Result<()> {
+        if !self.has_moving_meshes() {
+            return Ok(());
+        }
+        let moving = Triangles::of(scene, time_s, |m| m.animation.is_some());
+        let built = Bvh::build(&moving, self.static_nodes, self.static_triangles, true);
+        check_depth(built.depth, "moving meshes'")?;
+        let parts: [&[u8]; 3] = [
+            bytemuck::cast_slice(&built.nodes),
+            bytemuck::cast_slice(&built.triangles),
+            bytemuck::cast_slice(&built.shading),
+        ];
+        let targets = [
+            (
+                &self.nodes,
+                self.static_nodes as usize * std::mem::size_of::<BvhNode>(),
+            ),
+            (
+                &self.triangles,
+                self.static_triangles as usize * std::mem::size_of::<RayTriangle>(),
+            ),
+            (
+                &self.shading,
+                self.static_triangles as usize * std::mem::size_of::<RayShading>(),
+            ),
+        ];
+        let staging = &mut self.staging[slot];
+        let mut offset = 0;
+        let mut regions = Vec::new();
+        for (part, (target, at)) in parts.iter().zip(targets) {
+            staging.write(offset, part);
+            regions.push((target.raw, offset, at, part.len()));
+            offset += part.len();
+        }
+        let ctx = &self.ctx;
+        // Last frame's ray casts read the part rewritten now.
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ,
+            ),
+            (
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            ),
+        );
+        for (target, from, to, size) in regions {
+            let region = vk::BufferCopy::default()
+                .src_offset(from as u64)
+                .dst_offset(to as u64)
+                .size(size as u64);
+            unsafe {
+                ctx.device
+                    .cmd_copy_buffer(cmd, staging.raw, target, &[region])
+            };
+        }
+        let root = built.root(self.static_nodes);
+        unsafe {
+            ctx.device.cmd_update_buffer(
+                cmd,
+                self.uniforms.raw,
+                std::mem::offset_of!(RayUniforms, moving_root) as u64,
+                bytemuck::bytes_of(&root),
+            )
+        };
+        memory_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::UNIFORM_READ,
+            ),
+        );
+        Ok(())
+    }
+
+    /// GPU memory of the ray-casting resources, by name.
+    pub fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
+        vec![
+            ("ray_bvh_nodes", self.nodes.size),
+            ("ray_triangles", self.triangles.size + self.shading.size),
+            ("ray_texture_atlas", self.atlas.memory_bytes()),
+            ("ray_emitters", self.emitters.size),
+        ]
+    }
+}
+
+/// The emissive triangles of `bvh` (by their index in it), with their cumulative
+/// distribution by power (area x largest emitted radiance), and the total power.
+fn emitters(scene: &Scene, bvh: &Bvh) -> (Vec<RayEmitter>, f32) {
+    let mut list = Vec::new();
+    let mut total = 0.0f64;
+    for (i, tri) in bvh.triangles.iter().enumerate() {
+        let material = &scene.materials[tri.v0[3].to_bits() as usize];
+        let radiance = material.emission.max_element();
+        if radiance <= 0.0 {
+            continue;
+        }
+        let e1 = glam::Vec3::from_slice(&tri.e1[..3]);
+        let e2 = glam::Vec3::from_slice(&tri.e2[..3]);
+        let area = 0.5 * e1.cross(e2).length();
+        if area <= 0.0 {
+            continue;
+        }
+        total += f64::from(area * radiance);
+        list.push((i as u32, total));
+    }
+    let emitters = list
+        .iter()
+        .map(|&(triangle, cdf)| RayEmitter {
+            triangle,
+            cdf: (cdf / total) as f32,
+            ..Default::default()
+        })
+        .collect();
+    (emitters, total as f32)
+}
