@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+use crate::gi::path::cli::PathArgs;
 use crate::gi::vct::cli::VctArgs;
 use crate::gi::{DebugView, GiSettings};
 use crate::passes::shadow::ShadowResolution;
@@ -46,6 +47,9 @@ pub enum GiMode {
     /// textures (also accepted as `svo`).
     #[value(alias = "svo")]
     Octree,
+    /// The path-traced reference: a path tracer with next-event estimation, in the
+    /// references' conventions.
+    Path,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -89,6 +93,9 @@ pub struct CommonArgs {
     /// The cone tracer's options (--gi dense, --gi octree).
     #[command(flatten)]
     pub vct: VctArgs,
+    /// The path tracer's options (--gi path).
+    #[command(flatten)]
+    pub path: PathArgs,
     /// Leave out the direct light.
     #[arg(long)]
     pub no_direct: bool,
@@ -252,6 +259,16 @@ impl CommonArgs {
         if self.vct.octree_depth.is_some() && self.gi != GiMode::Octree {
             bail!("--octree-depth sets the sparse voxel octree: it needs --gi octree");
         }
+        if self.gi != GiMode::Path {
+            if let Some(option) = self.path.given().first() {
+                bail!("{option} sets the path tracer: it needs --gi path");
+            }
+        }
+        if !matches!(self.gi, GiMode::Dense | GiMode::Octree) {
+            if let Some(option) = self.vct.given().first() {
+                bail!("{option} works on the voxels: it needs --gi dense or --gi octree");
+            }
+        }
         let gi = match self.gi {
             GiMode::Dense | GiMode::Octree => {
                 let octree = self.gi == GiMode::Octree;
@@ -260,13 +277,14 @@ impl CommonArgs {
                 }
                 GiSettings::ConeTracing(self.vct.settings(octree, scene)?)
             }
+            GiMode::Path => {
+                let settings = self.path.settings(self.is_reference());
+                settings.check()?;
+                GiSettings::Path(settings)
+            }
             GiMode::Off => {
-                let mut needs_gi = self.vct.given();
                 if self.debug_view != DebugView::None {
-                    needs_gi.push("--debug-view");
-                }
-                if let Some(option) = needs_gi.first() {
-                    bail!("{option} works on the voxels: it needs --gi dense or --gi octree");
+                    bail!("--debug-view works on the voxels: it needs --gi dense or --gi octree");
                 }
                 GiSettings::Off
             }
@@ -349,7 +367,7 @@ mod tests {
     fn cone_tracing(settings: RenderSettings) -> VctSettings {
         match settings.gi {
             GiSettings::ConeTracing(vct) => vct,
-            GiSettings::Off => panic!("no cone tracing"),
+            _ => panic!("no cone tracing"),
         }
     }
 

@@ -254,7 +254,8 @@ gpu_layout! {
         /// `glsl/ray/rays.glsl`): `RayUniforms` uniform buffer.
         BINDING_RAY_UNIFORMS = 0;
         /// Ray casting (set 3): the BVHs' nodes, `BvhNode[]` storage buffer: the static
-        /// meshes' BVH from node 0, the moving meshes' after it (`RayUniforms.moving_root`).
+        /// meshes' BVH from node 0, the moving meshes' after it (`RayUniforms.moving_root`),
+        /// each depth first with escape indices, for traversal without a stack.
         BINDING_RAY_NODES = 1;
         /// Ray casting (set 3): the triangles in the BVHs' leaf order, `RayTriangle[]` storage
         /// buffer: a vertex, two edges and the material, as the intersection test reads them.
@@ -283,10 +284,16 @@ gpu_layout! {
         /// `RayTriangle.e2.w` bit: a moving mesh's (not among the emitters next-event
         /// estimation samples).
         RAY_MOVING = 2;
-        /// Entries of the traversal stack (a BVH of 2^24 triangles is about 30 levels deep).
-        RAY_STACK_SIZE = 48;
+        /// Bits of a leaf's first triangle in `BvhNode.max_leaf`: the BVHs hold fewer than 2^24
+        /// triangles.
+        RAY_LEAF_FIRST_BITS = 24;
+        /// Entries of the traversal stack: one per level at most (Sponza's BVH has 37).
+        RAY_STACK_SIZE = 64;
         /// Workgroup size of the batched ray queries.
         RAY_GROUP_SIZE = 64;
+        /// A cut-out seed (`glsl/ray/rays.glsl`) for rays that cut-outs stop whatever their
+        /// coverage.
+        RAY_OPAQUE = 0xFFFFFFFF;
         /// `RayQuery.kind`: the closest hit.
         RAY_CLOSEST = 0;
         /// `RayQuery.kind`: any hit (visibility).
@@ -598,12 +605,12 @@ gpu_layout! {
         ivec4 region_max,
     }
 
-    /// A node of a BVH2 over triangles (obvhs's layout): an inner node's children are nodes `first` and `first + 1`; a leaf's triangles are `first` to `first + count - 1`.
+    /// A node of a BVH2 over triangles, depth first: an inner node's first child follows it, and every node's escape is the node after its subtree (`RAY_NONE` after the last), where traversal goes on after missing its box or testing its leaf.
     struct BvhNode {
-        /// xyz bounds' minimum, w `first` (the bits of a uint).
-        vec4 min_first,
-        /// xyz bounds' maximum, w `count` (the bits of a uint): 0 for an inner node.
-        vec4 max_count,
+        /// xyz bounds' minimum, w the escape (the bits of a uint).
+        vec4 min_escape,
+        /// xyz bounds' maximum, w 0 for an inner node, for a leaf its first triangle in the low `RAY_LEAF_FIRST_BITS` bits and their count above (the bits of a uint).
+        vec4 max_leaf,
     }
 
     /// A triangle as the intersection test reads it.
@@ -688,24 +695,28 @@ gpu_layout! {
         float v,
     }
 
-    /// The path tracer's settings and progress.
+    /// The path tracer's settings.
     struct PathUniforms {
-        /// Samples already in `BINDING_PATH_SUM`: 0 starts the sum afresh.
-        uint samples_done,
-        /// Samples each pixel takes in this dispatch.
-        uint samples_now,
         /// Longest path in vertices counted from the camera (Mitsuba's `max_depth`: 2 is direct light only); 0 for no limit.
         uint max_depth,
         /// Russian roulette starts at this depth.
         uint rr_depth,
         /// The random sequence's seed.
         uint seed,
+        /// 1: cut-outs stop shadow rays whatever their coverage (the references' convention: their next-event estimation ignores Mitsuba's masks).
+        uint opaque_shadow_cut_outs,
+    }
+
+    /// Push constants of the path tracer: this dispatch's share of the samples.
+    struct PathPush {
+        /// Samples already in `BINDING_PATH_SUM`: 0 starts the sum afresh.
+        uint samples_done,
+        /// Samples each pixel takes in this dispatch (0: only the mean so far is written).
+        uint samples_now,
         /// Unused.
         uint pad0,
         /// Unused.
         uint pad1,
-        /// Unused.
-        uint pad2,
     }
 
     /// Push constants of every mesh draw.

@@ -110,9 +110,7 @@ impl Renderer {
             gi::create(&inputs, &settings.gi)?.map(|technique| (technique, screen))
         };
         let debug_views = gi.as_ref().map_or(&[][..], |(t, _)| t.debug_views());
-        let offered = DebugView::SCREEN.contains(&settings.debug_view)
-            || debug_views.contains(&settings.debug_view);
-        if settings.debug_view != DebugView::None && (gi.is_none() || !offered) {
+        if settings.debug_view != DebugView::None && !debug_views.contains(&settings.debug_view) {
             bail!(
                 "the debug view {:?} is not one of this technique's ({:?}): it needs \
                  --gi dense or --gi octree (octree-nodes: --gi octree)",
@@ -193,7 +191,7 @@ impl Renderer {
         self.composite
             .bind_input(&self.ctx, &t.radiance, self.nearest_sampler.raw);
         if let Some((technique, screen)) = &mut self.gi {
-            let request = technique.screen_request(t.gbuffer.extent());
+            let request = technique.bind_screen(t.gbuffer.extent())?;
             screen.bind(&t.gbuffer, &t.radiance, self.nearest_sampler.raw, request)?;
         }
         Ok(())
@@ -259,13 +257,8 @@ impl Renderer {
 
     /// The debug views of this renderer's technique, in the viewer's cycling order (none
     /// without GI).
-    pub fn debug_views(&self) -> Vec<DebugView> {
-        self.gi().map_or_else(Vec::new, |t| {
-            DebugView::SCREEN
-                .into_iter()
-                .chain(t.debug_views().iter().copied())
-                .collect()
-        })
+    pub fn debug_views(&self) -> &'static [DebugView] {
+        self.gi().map_or(&[], |t| t.debug_views())
     }
 
     /// GPU memory of the technique's resources, by name (empty without GI).
@@ -376,6 +369,9 @@ impl Renderer {
         let views: Vec<ShadowView> =
             shadow::scene_views(&self.scene, time_s, self.settings.shadow_resolution);
         let shadow_cones = self.gi_shades_direct();
+        // The shadow maps and the G-buffer: a technique that casts its own camera rays
+        // needs neither.
+        let raster = self.active_gi().is_none_or(|t| t.uses_raster_passes());
         let data = &mut self.frames[frame.slot];
         data.uniforms.write(0, bytemuck::bytes_of(&uniforms));
         data.lights.write(0, bytemuck::cast_slice(&lights));
@@ -390,41 +386,45 @@ impl Renderer {
         let timer = &mut data.timer;
         timer.reset(cmd);
 
-        let inputs: Vec<[[f32; 4]; 4]> = views
-            .iter()
-            .map(|v| v.view_proj)
-            .chain(
-                (0..self.scene.meshes.len())
-                    .map(|m| self.scene.mesh_transform(m, time_s).to_cols_array_2d()),
-            )
-            .collect();
-        // Soft-shadow cones need no shadow maps (the voxels are lit by a voxel ray-march
-        // then); they are rendered once all the same, so that they are valid when the
-        // viewer switches back.
-        let stale = !(self.settings.cache_shadows && self.shadow_inputs.as_ref() == Some(&inputs));
-        if self.shadow_inputs.is_none() || (!shadow_cones && stale) {
-            timer.begin(cmd, "shadow");
-            self.shadow.record(&ctx, cmd, &draw, &views);
-            timer.end(cmd);
-            self.shadow_inputs = Some(inputs);
-        }
-
-        timer.begin(cmd, "gbuffer");
-        let normal_maps = self.settings.normal_maps
-            && self
-                .scene
-                .materials
+        if raster {
+            let inputs: Vec<[[f32; 4]; 4]> = views
                 .iter()
-                .any(|m| m.normal_texture.is_some());
-        self.gbuffer_pass
-            .record(&ctx, cmd, &self.targets.gbuffer, &draw, normal_maps);
-        timer.end(cmd);
+                .map(|v| v.view_proj)
+                .chain(
+                    (0..self.scene.meshes.len())
+                        .map(|m| self.scene.mesh_transform(m, time_s).to_cols_array_2d()),
+                )
+                .collect();
+            // Soft-shadow cones need no shadow maps (the voxels are lit by a voxel
+            // ray-march then); they are rendered once all the same, so that they are valid
+            // when the viewer switches back.
+            let stale =
+                !(self.settings.cache_shadows && self.shadow_inputs.as_ref() == Some(&inputs));
+            if self.shadow_inputs.is_none() || (!shadow_cones && stale) {
+                timer.begin(cmd, "shadow");
+                self.shadow.record(&ctx, cmd, &draw, &views);
+                timer.end(cmd);
+                self.shadow_inputs = Some(inputs);
+            }
+
+            timer.begin(cmd, "gbuffer");
+            let normal_maps = self.settings.normal_maps
+                && self
+                    .scene
+                    .materials
+                    .iter()
+                    .any(|m| m.normal_texture.is_some());
+            self.gbuffer_pass
+                .record(&ctx, cmd, &self.targets.gbuffer, &draw, normal_maps);
+            timer.end(cmd);
+        }
 
         let indirect = self.indirect;
         let gi = self.gi.as_mut().filter(|_| indirect);
         if let Some((technique, _)) = gi {
             let inputs = FrameInputs {
                 draw: &draw,
+                uniforms: &uniforms,
                 slot: frame.slot,
                 lights: &lights,
                 views: &views,

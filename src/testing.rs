@@ -28,7 +28,7 @@ pub fn gi_settings(voxels: u32, store: Store, full_update: bool) -> RenderSettin
 pub fn cone_settings(settings: &mut RenderSettings) -> &mut VctSettings {
     match &mut settings.gi {
         GiSettings::ConeTracing(vct) => vct,
-        GiSettings::Off => panic!("the settings have no cone tracing"),
+        _ => panic!("the settings have no cone tracing"),
     }
 }
 

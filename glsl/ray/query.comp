@@ -22,12 +22,12 @@ void main() {
     RayQuery q = queries[i];
     RayHit answer = RayHit(RAY_NONE, q.direction_tmax.w, 0.0, 0.0);
     if (q.kind == RAY_ANY) {
-        if (trace_any(q.origin_tmin.xyz, q.direction_tmax.xyz, q.origin_tmin.w, q.direction_tmax.w)) {
+        if (trace_any(q.origin_tmin.xyz, q.direction_tmax.xyz, q.origin_tmin.w, q.direction_tmax.w, 0u)) {
             answer.triangle = 0u;
         }
     } else {
         Hit hit;
-        if (trace_closest(q.origin_tmin.xyz, q.direction_tmax.xyz, q.origin_tmin.w, q.direction_tmax.w, hit)) {
+        if (trace_closest(q.origin_tmin.xyz, q.direction_tmax.xyz, q.origin_tmin.w, q.direction_tmax.w, 0u, hit)) {
             answer = RayHit(floatBitsToUint(ray_triangles[hit.triangle].e1.w), hit.t, hit.bary.x, hit.bary.y);
         }
     }

@@ -2,10 +2,13 @@
 // over the scene's triangles (the static meshes', built once, and the moving meshes',
 // built every frame), traversed here: the closest hit, or any hit for visibility. Cut-out
 // materials (map_d, d < 1) let rays through where their coverage is below one half, as
-// the shadow maps and voxels count them.
+// the shadow maps and voxels count them; or, for a ray given a `cut_seed`, with the
+// probability 1 - coverage, as the path-traced references' Mitsuba masks do, or never
+// (`RAY_OPAQUE`: the references' shadow rays ignore the masks).
 #ifndef RAYS_GLSL
 #define RAYS_GLSL
 #include "gpu_layout.glsl"
+#include "common/random.glsl"
 
 layout(set = SET_GI, binding = BINDING_RAY_UNIFORMS) uniform RayBlock {
     RayUniforms rays;
@@ -80,10 +83,11 @@ vec2 triangle_uv(uint i, vec2 bary) {
 }
 
 // Whether triangle `i`, hit at `bary`, lets the ray through: a cut-out material with its
-// coverage (d x map_d) below one half there.
-bool cut_out(uint i, vec2 bary) {
+// coverage (d x map_d) below one half there (`cut_seed` 0), below a number drawn for this
+// ray and triangle (another seed), or never (`RAY_OPAQUE`).
+bool cut_out(uint i, vec2 bary, uint cut_seed) {
     RayTriangle tri = ray_triangles[i];
-    if ((floatBitsToUint(tri.e2.w) & RAY_CUT_OUT) == 0u) {
+    if ((floatBitsToUint(tri.e2.w) & RAY_CUT_OUT) == 0u || cut_seed == RAY_OPAQUE) {
         return false;
     }
     GpuMaterial m = ray_materials[floatBitsToUint(tri.v0.w)];
@@ -91,7 +95,8 @@ bool cut_out(uint i, vec2 bary) {
     if (m.coverage_texture != NO_TEXTURE) {
         coverage *= texture_bilinear(m.coverage_texture, triangle_uv(i, bary), false).r;
     }
-    return coverage < 0.5;
+    float threshold = cut_seed == 0u ? 0.5 : float(pcg_hash(cut_seed ^ i) >> 8u) * (1.0 / 16777216.0);
+    return coverage < threshold;
 }
 
 // Moeller-Trumbore: the distance to triangle `tri` along the ray and the barycentric
@@ -122,11 +127,11 @@ bool intersect_triangle(RayTriangle tri, vec3 origin, vec3 dir, float tmin, floa
     return t > tmin && t < tmax;
 }
 
-// The distance at which the ray enters node `n`'s box (slab test), or infinity when it
-// misses the box within (tmin, tmax).
-float enter_box(uint n, vec3 origin, vec3 inv_dir, float tmin, float tmax) {
-    vec3 lo = (bvh_nodes[n].min_first.xyz - origin) * inv_dir;
-    vec3 hi = (bvh_nodes[n].max_count.xyz - origin) * inv_dir;
+// The distance at which the ray enters box `n` within (tmin, tmax) (slab test), infinity
+// where it does not.
+float enter_box(BvhNode n, vec3 origin, vec3 inv_dir, float tmin, float tmax) {
+    vec3 lo = (n.min_escape.xyz - origin) * inv_dir;
+    vec3 hi = (n.max_leaf.xyz - origin) * inv_dir;
     vec3 near = min(lo, hi);
     vec3 far = max(lo, hi);
     float enter = max(max(near.x, near.y), max(near.z, tmin));
@@ -134,29 +139,34 @@ float enter_box(uint n, vec3 origin, vec3 inv_dir, float tmin, float tmax) {
     return enter <= leave ? enter : uintBitsToFloat(0x7f800000u);
 }
 
-// Walks the BVH rooted at `root`: the closest hit before `hit.t` (which it lowers), or with
-// `any`, the first one found. Returns whether it found one.
-bool traverse(uint root, vec3 origin, vec3 dir, float tmin, bool any, inout Hit hit) {
+// Walks the BVH rooted at `root`, the nearer child first (an inner node's first child
+// follows it, and its second is the node after the first's subtree: the first's
+// escape), the farther ones on a stack: the closest hit before `hit.t` (which it lowers),
+// or with `any`, the first one found. Returns whether it found one.
+bool traverse(uint root, vec3 origin, vec3 dir, float tmin, bool any, uint cut_seed, inout Hit hit) {
     if (root == RAY_NONE) {
         return false;
     }
     // A direction component of exactly zero divides to an infinity of the right sign.
     vec3 inv_dir = 1.0 / dir;
     uint stack[RAY_STACK_SIZE];
+    float stack_t[RAY_STACK_SIZE];
     int top = 0;
     bool found = false;
-    if (enter_box(root, origin, inv_dir, tmin, hit.t) > hit.t) {
+    uint node = root;
+    BvhNode n = bvh_nodes[node];
+    if (enter_box(n, origin, inv_dir, tmin, hit.t) > hit.t) {
         return false;
     }
-    uint node = root;
     while (true) {
-        uint count = floatBitsToUint(bvh_nodes[node].max_count.w);
-        uint first = floatBitsToUint(bvh_nodes[node].min_first.w);
-        if (count > 0u) {
+        uint leaf = floatBitsToUint(n.max_leaf.w);
+        if (leaf != 0u) {
+            uint first = leaf & ((1u << RAY_LEAF_FIRST_BITS) - 1u);
+            uint count = leaf >> RAY_LEAF_FIRST_BITS;
             for (uint i = first; i < first + count; i++) {
                 float t;
                 vec2 bary;
-                if (intersect_triangle(ray_triangles[i], origin, dir, tmin, hit.t, t, bary) && !cut_out(i, bary)) {
+                if (intersect_triangle(ray_triangles[i], origin, dir, tmin, hit.t, t, bary) && !cut_out(i, bary, cut_seed)) {
                     hit.triangle = i;
                     hit.t = t;
                     hit.bary = bary;
@@ -167,30 +177,42 @@ bool traverse(uint root, vec3 origin, vec3 dir, float tmin, bool any, inout Hit 
                 }
             }
         } else {
-            float near = enter_box(first, origin, inv_dir, tmin, hit.t);
-            float far = enter_box(first + 1u, origin, inv_dir, tmin, hit.t);
-            uint a = first;
-            uint b = first + 1u;
-            if (far < near) {
-                float swap_t = near;
-                near = far;
-                far = swap_t;
-                a = first + 1u;
-                b = first;
+            uint a = node + 1u;
+            BvhNode na = bvh_nodes[a];
+            uint b = floatBitsToUint(na.min_escape.w);
+            BvhNode nb = bvh_nodes[b];
+            float ta = enter_box(na, origin, inv_dir, tmin, hit.t);
+            float tb = enter_box(nb, origin, inv_dir, tmin, hit.t);
+            if (tb < ta) {
+                uint swap_node = a;
+                a = b;
+                b = swap_node;
+                BvhNode swap_box = na;
+                na = nb;
+                nb = swap_box;
+                float swap_t = ta;
+                ta = tb;
+                tb = swap_t;
             }
-            if (near <= hit.t) {
-                if (far <= hit.t && top < RAY_STACK_SIZE) {
-                    stack[top++] = b;
+            if (ta <= hit.t) {
+                // The BVHs are shallower than the stack (checked when built).
+                if (tb <= hit.t) {
+                    stack[top] = b;
+                    stack_t[top] = tb;
+                    top++;
                 }
                 node = a;
+                n = na;
                 continue;
             }
         }
-        // Pop the next box the ray still enters before the closest hit so far.
+        // The next box on the stack the ray still enters before the closest hit so far.
         bool next = false;
         while (top > 0) {
-            node = stack[--top];
-            if (enter_box(node, origin, inv_dir, tmin, hit.t) <= hit.t) {
+            top--;
+            if (stack_t[top] <= hit.t) {
+                node = stack[top];
+                n = bvh_nodes[node];
                 next = true;
                 break;
             }
@@ -202,23 +224,24 @@ bool traverse(uint root, vec3 origin, vec3 dir, float tmin, bool any, inout Hit 
     return found;
 }
 
-// The closest hit along the ray within (tmin, tmax).
-bool trace_closest(vec3 origin, vec3 dir, float tmin, float tmax, out Hit hit) {
+// The closest hit along the ray within (tmin, tmax); `cut_seed` as `cut_out` takes it.
+bool trace_closest(vec3 origin, vec3 dir, float tmin, float tmax, uint cut_seed, out Hit hit) {
     hit.triangle = RAY_NONE;
     hit.t = tmax;
     hit.bary = vec2(0.0);
-    bool found = traverse(rays.static_root, origin, dir, tmin, false, hit);
-    found = traverse(rays.moving_root, origin, dir, tmin, false, hit) || found;
+    bool found = traverse(rays.static_root, origin, dir, tmin, false, cut_seed, hit);
+    found = traverse(rays.moving_root, origin, dir, tmin, false, cut_seed, hit) || found;
     return found;
 }
 
-// Whether anything lies along the ray within (tmin, tmax).
-bool trace_any(vec3 origin, vec3 dir, float tmin, float tmax) {
+// Whether anything lies along the ray within (tmin, tmax); `cut_seed` as `cut_out` takes
+// it.
+bool trace_any(vec3 origin, vec3 dir, float tmin, float tmax, uint cut_seed) {
     Hit hit;
     hit.triangle = RAY_NONE;
     hit.t = tmax;
     hit.bary = vec2(0.0);
-    return traverse(rays.static_root, origin, dir, tmin, true, hit) ||
-           traverse(rays.moving_root, origin, dir, tmin, true, hit);
+    return traverse(rays.static_root, origin, dir, tmin, true, cut_seed, hit) ||
+           traverse(rays.moving_root, origin, dir, tmin, true, cut_seed, hit);
 }
 #endif

@@ -126,7 +126,7 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
         }
         totals.push(frame.values().sum());
     }
-    let passes = samples
+    let passes: BTreeMap<String, PassStats> = samples
         .iter()
         .map(|(name, v)| (name.clone(), stats(v)))
         .collect();
@@ -147,6 +147,13 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
                 println!("  {name:<14} {ms:9.2}");
             }
             prepare_passes = preparation.passes;
+        }
+    }
+    // A technique that counts its rays (`--gi path`) gets its rate over its trace pass.
+    if let (Some(rays), Some(pass)) = (stats_map.get("rays_per_frame"), passes.get("path_trace")) {
+        let seconds: f64 = pass.median_ms / 1e3;
+        if seconds > 0.0 {
+            stats_map.insert("rays_per_second".to_string(), rays / seconds);
         }
     }
     let report = BenchReport {

@@ -8,6 +8,7 @@ use ash::vk;
 
 use super::{check_validation, create_context, load_scene, Offscreen};
 use crate::cli::{RenderArgs, MAX_IMAGE_SIDE};
+use crate::gi::Progress;
 use crate::imageio::{box_downsample, box_downsample_srgb8};
 use crate::renderer::{OutputTarget, Renderer};
 use crate::vk::{copy_image_to_buffer, Buffer, ImageUse};
@@ -33,10 +34,20 @@ fn output_format(path: &Path) -> Result<Format> {
     }
 }
 
-/// Renders one frame and writes it; returns the path written.
+/// Renders the frame and writes it; returns the path written. A technique that converges
+/// over frames (`--gi path`) renders frames until it has its samples, with a progress bar.
 pub fn run(args: &RenderArgs) -> Result<PathBuf> {
     let format = output_format(&args.output)?;
-    let samples = args.supersample;
+    let scene = load_scene(&args.common)?;
+    let settings = args.common.render_settings(&scene.gi)?;
+    let samples = if settings.gi.filters_pixels() {
+        if args.supersample != 1 {
+            log::info!("the technique filters each pixel itself: one sample per pixel to render");
+        }
+        1
+    } else {
+        args.supersample
+    };
     let (width, height) = (args.size.0 * samples, args.size.1 * samples);
     if width.max(height) > MAX_IMAGE_SIDE {
         bail!(
@@ -47,8 +58,6 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
         );
     }
     let ctx = create_context(&args.common, Vec::new())?;
-    let scene = load_scene(&args.common)?;
-    let settings = args.common.render_settings(&scene.gi)?;
     let extent = vk::Extent2D { width, height };
     let offscreen = Offscreen::new(&ctx, extent)?;
     let mut renderer = Renderer::new(&ctx, scene, settings, extent, super::LDR_FORMAT)?;
@@ -60,31 +69,61 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
         gpu_allocator::MemoryLocation::GpuToCpu,
     )?;
     let start = Instant::now();
-    let target = OutputTarget {
-        image: offscreen.image.raw,
-        view: offscreen.image.view,
-        extent,
-        before: ImageUse::UNDEFINED,
-        after: ImageUse::TRANSFER_SRC,
-    };
-    let frame = renderer.begin_frame()?;
-    renderer.record_frame(&frame, args.common.time, &target)?;
-    match format {
-        Format::Exr => renderer.record_radiance_readback(frame.cmd, &radiance),
-        Format::Png => copy_image_to_buffer(
-            &ctx,
-            frame.cmd,
-            offscreen.image.raw,
+    let mut bar = Bar::new(renderer.gi().and_then(|t| t.progress()));
+    for index in 0.. {
+        let progress = renderer.gi().and_then(|t| t.progress());
+        let last = progress.is_none_or(|p| p.frames_left <= 1);
+        let target = OutputTarget {
+            image: offscreen.image.raw,
+            view: offscreen.image.view,
             extent,
-            offscreen.readback.raw,
-        ),
+            before: if index == 0 {
+                ImageUse::UNDEFINED
+            } else {
+                ImageUse::discard_after(ImageUse::TRANSFER_SRC)
+            },
+            after: ImageUse::TRANSFER_SRC,
+        };
+        let frame = renderer.begin_frame()?;
+        renderer.record_frame(&frame, args.common.time, &target)?;
+        if last {
+            match format {
+                Format::Exr => renderer.record_radiance_readback(frame.cmd, &radiance),
+                Format::Png => copy_image_to_buffer(
+                    &ctx,
+                    frame.cmd,
+                    offscreen.image.raw,
+                    extent,
+                    offscreen.readback.raw,
+                ),
+            }
+        }
+        renderer.submit(frame, None, None)?;
+        if last {
+            break;
+        }
+        if index == 0 {
+            // The first frame, waited for, gives the estimate of the whole render.
+            renderer.finish()?;
+            let frames = progress.map_or(1, |p| p.frames_left);
+            let estimate = start.elapsed().as_secs_f64() * f64::from(frames);
+            log::info!(
+                "{frames} frames to render, about {} in all",
+                duration_text(estimate)
+            );
+        }
+        bar.update(renderer.gi().and_then(|t| t.progress()));
     }
-    renderer.submit(frame, None, None)?;
     renderer.finish()?;
+    bar.finish();
     log::info!(
-        "rendered {}x{} ({samples}x{samples} samples per pixel) in {:.1} ms (GPU: {})",
+        "rendered {}x{} ({}) in {:.1} ms (last frame's GPU: {})",
         args.size.0,
         args.size.1,
+        match renderer.gi().and_then(|t| t.progress()) {
+            Some(p) => format!("{} samples per pixel", p.done),
+            None => format!("{samples}x{samples} samples per pixel"),
+        },
         start.elapsed().as_secs_f64() * 1e3,
         renderer
             .timings
@@ -108,4 +147,57 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
     .with_context(|| format!("writing {}", args.output.display()))?;
     check_validation(&ctx)?;
     Ok(args.output.clone())
+}
+
+/// `seconds` as "1 h 5 min", "3 min 20 s" or "12.3 s".
+fn duration_text(seconds: f64) -> String {
+    let whole = seconds.round() as u64;
+    if whole >= 3600 {
+        format!("{} h {} min", whole / 3600, whole % 3600 / 60)
+    } else if whole >= 60 {
+        format!("{} min {} s", whole / 60, whole % 60)
+    } else {
+        format!("{seconds:.1} s")
+    }
+}
+
+/// The progress of a render that converges over frames: a bar on a terminal, else a log
+/// line at each quarter.
+struct Bar {
+    bar: Option<indicatif::ProgressBar>,
+    quarter: u32,
+}
+
+impl Bar {
+    fn new(progress: Option<Progress>) -> Self {
+        let bar = progress.filter(|p| p.frames_left > 1).map(|p| {
+            let bar = indicatif::ProgressBar::new(u64::from(p.total));
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{bar:40} {pos}/{len} samples per pixel, {elapsed} so far, {eta} left",
+                )
+                .expect("a valid progress template"),
+            );
+            bar
+        });
+        Self { bar, quarter: 0 }
+    }
+
+    fn update(&mut self, progress: Option<Progress>) {
+        let (Some(bar), Some(p)) = (&self.bar, progress) else {
+            return;
+        };
+        bar.set_position(u64::from(p.done));
+        let quarter = 4 * p.done / p.total.max(1);
+        if bar.is_hidden() && quarter > self.quarter && quarter < 4 {
+            log::info!("{} of {} samples per pixel", p.done, p.total);
+        }
+        self.quarter = quarter;
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
 }

@@ -9,8 +9,10 @@
 //!
 //! A technique is a folder here with its shaders in the `glsl/gi/` folder of the same
 //! name, an arm of [`GiSettings`] and of [`create`]; README.md, "Adding a technique",
-//! lists what else it touches.
+//! lists what else it touches. Today: voxel cone tracing ([`vct`]) and the path-traced
+//! reference ([`path`]).
 
+pub mod path;
 pub mod screen;
 pub mod vct;
 
@@ -21,7 +23,7 @@ use anyhow::Result;
 use ash::vk;
 
 pub use self::screen::{Screen, ScreenRequest};
-use crate::gpu_layout::{self as layout, GpuLight, ShadowView};
+use crate::gpu_layout::{self as layout, FrameUniforms, GpuLight, ShadowView};
 use crate::scene::Scene;
 use crate::scene_gpu::{GpuScene, SceneDraw};
 use crate::vk::{Context, GpuTimer};
@@ -34,6 +36,16 @@ pub enum GiSettings {
     Off,
     /// Voxel cone tracing, on a dense grid or an octree ([`vct`]).
     ConeTracing(vct::VctSettings),
+    /// The path-traced reference ([`path`]).
+    Path(path::PathSettings),
+}
+
+impl GiSettings {
+    /// Whether the technique filters each pixel itself (a path tracer's jittered camera
+    /// rays), so that rendering more samples per pixel adds nothing.
+    pub fn filters_pixels(&self) -> bool {
+        matches!(self, GiSettings::Path(_))
+    }
 }
 
 /// What every technique is created from.
@@ -53,6 +65,7 @@ pub fn create(inputs: &Inputs, settings: &GiSettings) -> Result<Option<Box<dyn T
     Ok(match settings {
         GiSettings::Off => None,
         GiSettings::ConeTracing(vct) => Some(vct::create(inputs, vct)?),
+        GiSettings::Path(path) => Some(Box::new(path::PathTracer::new(inputs, path)?)),
     })
 }
 
@@ -79,7 +92,7 @@ pub enum DebugView {
 
 impl DebugView {
     /// The views of the screen contract's terms, which every technique that gathers
-    /// them has (a technique adds its own: [`Technique::debug_views`]).
+    /// them has.
     pub const SCREEN: [DebugView; 3] = [DebugView::None, DebugView::Indirect, DebugView::Ao];
 
     /// `FrameUniforms.debug_view`.
@@ -110,6 +123,8 @@ impl DebugView {
 /// What a frame gives a technique's update.
 pub struct FrameInputs<'a> {
     pub draw: &'a SceneDraw<'a>,
+    /// The frame's uniforms (camera, image size, flags), as the GPU sees them.
+    pub uniforms: &'a FrameUniforms,
     /// The frame's slot in flight (the frame recorded that many frames ago used it last).
     pub slot: usize,
     /// The lights as the GPU sees them this frame.
@@ -145,6 +160,17 @@ pub struct Switch<'a> {
     pub on: &'a mut bool,
 }
 
+/// How far a technique that converges over frames has come (a path tracer's samples).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Samples per pixel recorded so far.
+    pub done: u32,
+    /// Samples per pixel it converges to.
+    pub total: u32,
+    /// Frames still to record to get there, the next one included (1 for the last).
+    pub frames_left: u32,
+}
+
 /// A technique's work before the first frame, as `bench` reports it.
 pub struct Preparation {
     /// One line: what was prepared and how long it took.
@@ -158,8 +184,10 @@ pub trait Technique: Any {
     /// Work before the first frame, waited for (the octree's build).
     fn prepare(&mut self, draw: &SceneDraw) -> Result<()>;
 
-    /// How the screen contract's targets are to be laid out for a frame of `extent`.
-    fn screen_request(&self, extent: vk::Extent2D) -> ScreenRequest;
+    /// Makes the technique's screen-sized resources for frames of `extent` (no frame
+    /// using the old ones is in flight) and says how the screen contract's terms are to be
+    /// laid out.
+    fn bind_screen(&mut self, extent: vk::Extent2D) -> Result<ScreenRequest>;
 
     /// Records the technique's update, after the shadow maps and the G-buffer and before
     /// the lighting pass.
@@ -199,7 +227,7 @@ pub trait Technique: Any {
     /// The last preparation, if the technique prepares anything.
     fn preparation(&self) -> Option<Preparation>;
 
-    /// The technique's own debug views, beyond [`DebugView::SCREEN`].
+    /// The debug views the technique offers, [`DebugView::None`] first.
     fn debug_views(&self) -> &'static [DebugView];
 
     /// The highest `--debug-level` its views have.
@@ -207,4 +235,16 @@ pub trait Technique: Any {
 
     /// The switches the viewer offers.
     fn switches(&mut self) -> Vec<Switch<'_>>;
+
+    /// Whether the frame's shadow maps and G-buffer feed the technique (a path tracer
+    /// casts its own camera rays: without them, neither is drawn).
+    fn uses_raster_passes(&self) -> bool {
+        true
+    }
+
+    /// How far a technique that converges over frames has come; `None` for one whose
+    /// every frame is complete.
+    fn progress(&self) -> Option<Progress> {
+        None
+    }
 }

@@ -69,16 +69,8 @@ pub struct SceneRays {
 /// The stages that cast rays.
 const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::COMPUTE;
 
-/// The deepest BVH whose traversal the stack holds.
-fn check_depth(depth: u32, what: &str) -> Result<()> {
-    if depth >= layout::RAY_STACK_SIZE {
-        bail!(
-            "the {what} BVH is {depth} levels deep, more than the {} its traversal stack holds",
-            layout::RAY_STACK_SIZE
-        );
-    }
-    Ok(())
-}
+/// The most triangles the BVHs hold (a leaf's first triangle has `RAY_LEAF_FIRST_BITS`).
+const MAX_TRIANGLES: usize = 1 << layout::RAY_LEAF_FIRST_BITS;
 
 impl SceneRays {
     /// The set-3 bindings every ray-casting pass starts with.
@@ -109,10 +101,15 @@ impl SceneRays {
     /// `frames_in_flight` frames may be recorded before the first is done.
     pub fn new(ctx: &Arc<Context>, scene: &Scene, frames_in_flight: usize) -> Result<Self> {
         let start = Instant::now();
+        let triangle_count: usize = scene.meshes.iter().map(|m| m.indices.len() / 3).sum();
+        if triangle_count >= MAX_TRIANGLES {
+            bail!(
+                "the scene has {triangle_count} triangles: ray casting holds fewer than {MAX_TRIANGLES}"
+            );
+        }
         let statics = Triangles::of(scene, 0.0, |m| m.animation.is_none());
         let built = Bvh::build(&statics, 0, 0, false);
         let depth = built.depth;
-        check_depth(depth, "static meshes'")?;
         let stats = BuildStats {
             triangles: statics.len(),
             nodes: built.nodes.len(),
@@ -301,7 +298,6 @@ impl SceneRays {
         }
         let moving = Triangles::of(scene, time_s, |m| m.animation.is_some());
         let built = Bvh::build(&moving, self.static_nodes, self.static_triangles, true);
-        check_depth(built.depth, "moving meshes'")?;
         let parts: [&[u8]; 3] = [
             bytemuck::cast_slice(&built.nodes),
             bytemuck::cast_slice(&built.triangles),

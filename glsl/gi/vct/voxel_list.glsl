@@ -25,7 +25,7 @@ layout(set = SET_GI, binding = BINDING_VCT_VOXEL_LIST, std430) buffer VoxelListB
 #endif
 
 #ifdef VOXEL_LIST_WRITER
-#include "gi/vct/subgroup_add.glsl"
+#include "common/subgroup_add.glsl"
 // Where this invocation's `entries` entries start (its subgroup takes them with one
 // atomic add); raises the indirect dispatch to cover them.
 uint take_list_entries(uint entries) {

@@ -81,6 +81,20 @@ impl VctArgs {
         [
             (self.shadow_cones, "--shadow-cones"),
             (self.full_update, "--full-update"),
+            (self.voxels.is_some(), "--voxels"),
+            (self.octree_depth.is_some(), "--octree-depth"),
+            (self.diffuse_aperture.is_some(), "--diffuse-aperture"),
+            (self.step_factor.is_some(), "--step-factor"),
+            (self.bounce_step_factor.is_some(), "--bounce-step-factor"),
+            (self.shadow_step_factor.is_some(), "--shadow-step-factor"),
+            (self.wide_steps_by_level, "--wide-steps-by-level"),
+            (self.diffuse_cones.is_some(), "--diffuse-cones"),
+            (self.indirect_scale.is_some(), "--indirect-scale"),
+            (self.no_accumulate, "--no-accumulate"),
+            (self.bounces.is_some(), "--bounces"),
+            (self.shadow_aperture.is_some(), "--shadow-aperture"),
+            (self.ao_distance.is_some(), "--ao-distance"),
+            (self.voxelizer != Voxelizer::Auto, "--voxelizer"),
         ]
         .into_iter()
         .filter_map(|(set, flag)| set.then_some(flag))

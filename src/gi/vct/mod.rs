@@ -78,7 +78,8 @@ pub struct Voxels {
 /// (`glsl/gi/vct/sampling.glsl`).
 pub trait VoxelStore: Sized + 'static {
     const SHADERS: StoreShaders;
-    /// The debug views of the store's voxels.
+    /// The debug views: the screen's ([`DebugView::SCREEN`]) and those of the store's
+    /// voxels.
     const DEBUG_VIEWS: &'static [DebugView];
 
     /// The store's own set-3 bindings, after the shared ones.
@@ -404,14 +405,14 @@ impl<S: VoxelStore> Technique for ConeTracing<S> {
     /// The cones are traced on one pixel of each block (the settings' scale, or one
     /// chosen from the image height), and the upsample keeps samples within two voxels of
     /// a pixel's plane.
-    fn screen_request(&self, extent: vk::Extent2D) -> ScreenRequest {
-        ScreenRequest {
+    fn bind_screen(&mut self, extent: vk::Extent2D) -> Result<ScreenRequest> {
+        Ok(ScreenRequest {
             scale: self
                 .indirect_scale
                 .unwrap_or_else(|| auto_indirect_scale(extent.height))
                 .max(1),
             plane_tolerance: 2.0 * self.grid().voxel_size,
-        }
+        })
     }
 
     /// Voxelizes the scene and lights and filters the voxels (after the shadow maps).

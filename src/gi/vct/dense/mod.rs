@@ -159,6 +159,9 @@ impl VoxelStore for Dense {
     };
 
     const DEBUG_VIEWS: &'static [DebugView] = &[
+        DebugView::None,
+        DebugView::Indirect,
+        DebugView::Ao,
         DebugView::VoxelAlbedo,
         DebugView::VoxelNormal,
         DebugView::VoxelRadiance,

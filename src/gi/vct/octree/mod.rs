@@ -136,6 +136,9 @@ impl VoxelStore for Octree {
     };
 
     const DEBUG_VIEWS: &'static [DebugView] = &[
+        DebugView::None,
+        DebugView::Indirect,
+        DebugView::Ao,
         DebugView::VoxelAlbedo,
         DebugView::VoxelNormal,
         DebugView::VoxelRadiance,

@@ -9,7 +9,7 @@
 #include "gi/vct/octree/octree.glsl"
 
 #ifdef SUBGROUP_APPEND
-#include "gi/vct/subgroup_add.glsl"
+#include "common/subgroup_add.glsl"
 // The compute voxelizer's lanes take their records together with their subgroup.
 uint append_fragment() {
     uint index;

@@ -8,7 +8,7 @@
 // static brick and sums stay as built and the next frame finds them again. A pool that
 // runs out is reported in `counters.overflow`; the host grows it and builds again.
 #include "gi/vct/octree/nodes/level.glsl"
-#include "gi/vct/subgroup_add.glsl"
+#include "common/subgroup_add.glsl"
 
 void main() {
     uint node;

@@ -1,0 +1,239 @@
+#version 460
+// The path-traced reference (`--gi path`): a unidirectional path tracer with next-event
+// estimation and multiple importance sampling (Veach 1997), as the references' Mitsuba 3
+// integrator: two-sided Lambertian surfaces of albedo Kd x map_Kd, one-sided emitters
+// (MTL Ke, along the winding normal), cut-outs passing rays with the probability 1 -
+// coverage (and, under the references' conventions, stopping every shadow ray: the
+// references' next-event estimation ignores Mitsuba's masks), the scene's point, spot and
+// directional lights in the lighting pass's units, a constant sky, a box pixel filter,
+// Russian roulette from `rr_depth` on. Each invocation adds `samples_now` samples to its pixel's running sum
+// and writes the mean so far to the screen radiance.
+#include "common/direct_light.glsl"
+#include "common/random.glsl"
+#include "common/subgroup_add.glsl"
+#include "ray/rays.glsl"
+
+layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
+layout(set = SET_GI, binding = BINDING_PATH_UNIFORMS) uniform PathBlock {
+    PathUniforms path;
+};
+layout(set = SET_GI, binding = BINDING_PATH_SUM, rgba32f) uniform image2D path_sum;
+layout(set = SET_GI, binding = BINDING_PATH_RAYS, std430) buffer PathRayBlock {
+    uint rays_cast;
+};
+layout(set = SET_SCREEN, binding = BINDING_SCREEN_RADIANCE, rgba32f) uniform writeonly image2D screen_radiance;
+layout(push_constant) uniform Push {
+    PathPush push;
+};
+
+// Rays this invocation cast.
+uint rays_here = 0u;
+
+// Where a path met a surface, as the next vertex sees it.
+struct Surface {
+    vec3 p;
+    // The geometric normal on the side the ray came from.
+    vec3 ng;
+    // The shading normal, turned to that side too (two-sided shading).
+    vec3 ns;
+    vec3 albedo;
+    // Emitted radiance towards the ray's origin (zero from the back of an emitter).
+    vec3 emitted;
+};
+
+Surface surface_at(Hit hit, vec3 dir) {
+    RayTriangle tri = ray_triangles[hit.triangle];
+    RayShading sh = ray_shading[hit.triangle];
+    GpuMaterial m = ray_materials[floatBitsToUint(tri.v0.w)];
+    float w = 1.0 - hit.bary.x - hit.bary.y;
+    Surface s;
+    s.p = tri.v0.xyz + tri.e1.xyz * hit.bary.x + tri.e2.xyz * hit.bary.y;
+    vec3 winding = normalize(cross(tri.e1.xyz, tri.e2.xyz));
+    bool front = dot(winding, dir) < 0.0;
+    s.ng = front ? winding : -winding;
+    vec3 ns = sh.n0.xyz * w + sh.n1.xyz * hit.bary.x + sh.n2.xyz * hit.bary.y;
+    ns = dot(ns, ns) > 1e-12 ? normalize(ns) : s.ng;
+    s.ns = dot(ns, s.ng) < 0.0 ? -ns : ns;
+    s.albedo = m.albedo.rgb;
+    if (m.albedo_texture != NO_TEXTURE) {
+        s.albedo *= texture_bilinear(m.albedo_texture, triangle_uv(hit.triangle, hit.bary), true).rgb;
+    }
+    s.emitted = front ? m.emission.rgb : vec3(0.0);
+    return s;
+}
+
+// The power heuristic (beta = 2) for a sample drawn with density `a` against another
+// technique's density `b` for the same direction, as Mitsuba's path integrator weighs.
+float mis_weight(float a, float b) {
+    a *= a;
+    b *= b;
+    return a + b > 0.0 ? a / (a + b) : 0.0;
+}
+
+// A direction about `n` with density cos(theta) / pi.
+vec3 sample_cosine(vec3 n, inout uint rng) {
+    float r = sqrt(random_next(rng));
+    float phi = 6.2831853 * random_next(rng);
+    vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
+    vec3 b = cross(n, t);
+    return normalize(r * cos(phi) * t + r * sin(phi) * b + sqrt(max(1.0 - r * r, 0.0)) * n);
+}
+
+// The density, in solid angle at a point `dist` away, with which next-event estimation
+// picks a point of an emitter of largest radiance `largest` seen at `cos_light`: emitters
+// are picked by power (area x largest radiance) and points uniformly by area, so the
+// area cancels.
+float emitter_pdf(float largest, float dist, float cos_light) {
+    return largest / rays.emitter_power * dist * dist / max(cos_light, 1e-12);
+}
+
+// A seed for one ray's random cut-out decisions (neither 0, the fixed threshold, nor
+// `RAY_OPAQUE`).
+uint cut_seed(inout uint rng) {
+    return (pcg_hash(uint(random_next(rng) * 16777216.0)) | 1u) & ~2u;
+}
+
+// Whether nothing lies between `origin` and the point `dist` along `dir`; under the
+// references' conventions cut-outs stop these rays whatever their coverage.
+bool visible(vec3 origin, vec3 dir, float dist, inout uint rng) {
+    rays_here++;
+    uint seed = path.opaque_shadow_cut_outs != 0u ? RAY_OPAQUE : cut_seed(rng);
+    return !trace_any(origin, dir, 0.0, dist, seed);
+}
+
+// Radiance from the scene's point, spot and directional lights scattered at `s` towards
+// the path, shadowed by rays.
+vec3 delta_lights(Surface s, vec3 origin, inout uint rng) {
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < frame.light_count; i++) {
+        vec3 l;
+        float dist;
+        vec3 e = light_arriving(lights[i], s.p, l, dist);
+        float cos_s = dot(s.ns, l);
+        if (cos_s <= 0.0 || dot(s.ng, l) <= 0.0 || all(equal(e, vec3(0.0)))) {
+            continue;
+        }
+        float reach = lights[i].kind == LIGHT_DIRECTIONAL ? 1e30 : dist - 2.0 * rays.epsilon;
+        if (visible(origin, l, reach, rng)) {
+            sum += s.albedo / PI * e * cos_s;
+        }
+    }
+    return sum;
+}
+
+// Radiance from one emitter point picked by power, weighted against cosine sampling.
+vec3 emitter_light(Surface s, vec3 origin, inout uint rng) {
+    if (rays.emitter_count == 0u) {
+        return vec3(0.0);
+    }
+    float pick = random_next(rng);
+    uint lo = 0u;
+    uint hi = rays.emitter_count - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi) / 2u;
+        if (emitters[mid].cdf < pick) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    RayTriangle tri = ray_triangles[emitters[lo].triangle];
+    float su = sqrt(random_next(rng));
+    float r = random_next(rng);
+    vec3 q = tri.v0.xyz + su * (1.0 - r) * tri.e1.xyz + su * r * tri.e2.xyz;
+    vec3 to = q - origin;
+    float dist = length(to);
+    vec3 l = to / dist;
+    vec3 winding = normalize(cross(tri.e1.xyz, tri.e2.xyz));
+    float cos_light = -dot(winding, l);
+    float cos_s = dot(s.ns, l);
+    if (cos_light <= 0.0 || cos_s <= 0.0 || dot(s.ng, l) <= 0.0 || !visible(origin, l, dist * (1.0 - 1e-4), rng)) {
+        return vec3(0.0);
+    }
+    vec3 radiance = ray_materials[floatBitsToUint(tri.v0.w)].emission.rgb;
+    float light_pdf = emitter_pdf(max(radiance.r, max(radiance.g, radiance.b)), dist, cos_light);
+    float weight = mis_weight(light_pdf, cos_s / PI);
+    return s.albedo / PI * radiance * cos_s * weight / light_pdf;
+}
+
+// One path through `pixel`, its camera ray jittered over the pixel (a box filter).
+vec3 trace_path(uvec2 pixel, inout uint rng) {
+    vec2 at = (vec2(pixel) + vec2(random_next(rng), random_next(rng))) / vec2(frame.width, frame.height);
+    vec4 through = frame.inv_view_proj * vec4(at * 2.0 - 1.0, 0.5, 1.0);
+    vec3 origin = frame.camera_position.xyz;
+    vec3 dir = normalize(through.xyz / through.w - origin);
+    uint max_depth = path.max_depth == 0u ? 0xffffffffu : path.max_depth;
+    vec3 radiance = vec3(0.0);
+    vec3 throughput = vec3(1.0);
+    // The density of the direction the path took last, 0 for the camera ray (whose hit
+    // of an emitter no other technique samples).
+    float bsdf_pdf = 0.0;
+    for (uint depth = 1u;; depth++) {
+        Hit hit;
+        rays_here++;
+        if (!trace_closest(origin, dir, 0.0, 1e30, cut_seed(rng), hit)) {
+            radiance += throughput * frame.sky_radiance.rgb;
+            break;
+        }
+        Surface s = surface_at(hit, dir);
+        if (any(greaterThan(s.emitted, vec3(0.0)))) {
+            float weight = 1.0;
+            RayTriangle tri = ray_triangles[hit.triangle];
+            bool sampled = (floatBitsToUint(tri.e2.w) & RAY_MOVING) == 0u && rays.emitter_count > 0u;
+            if (bsdf_pdf > 0.0 && sampled) {
+                float largest = max(s.emitted.r, max(s.emitted.g, s.emitted.b));
+                weight = mis_weight(bsdf_pdf, emitter_pdf(largest, hit.t, dot(s.ng, -dir)));
+            }
+            radiance += throughput * s.emitted * weight;
+        }
+        if (depth >= max_depth) {
+            break;
+        }
+        vec3 from = s.p + s.ng * rays.epsilon;
+        radiance += throughput * (delta_lights(s, from, rng) + emitter_light(s, from, rng));
+        vec3 next = sample_cosine(s.ns, rng);
+        float cos_next = dot(s.ns, next);
+        if (cos_next <= 0.0 || dot(s.ng, next) <= 0.0) {
+            break;
+        }
+        throughput *= s.albedo;
+        bsdf_pdf = cos_next / PI;
+        if (depth >= path.rr_depth) {
+            float survive = min(max(throughput.r, max(throughput.g, throughput.b)), 0.95);
+            if (random_next(rng) >= survive) {
+                break;
+            }
+            throughput /= survive;
+        }
+        origin = from;
+        dir = next;
+    }
+    return radiance;
+}
+
+void main() {
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    bool inside = pixel.x < frame.width && pixel.y < frame.height;
+    vec4 sum = vec4(0.0);
+    if (inside) {
+        if (push.samples_done > 0u) {
+            sum = imageLoad(path_sum, ivec2(pixel));
+        }
+        for (uint i = 0u; i < push.samples_now; i++) {
+            uint rng = random_seed(pixel, push.samples_done + i, path.seed);
+            vec3 l = trace_path(pixel, rng);
+            // A sample lost to a numerical failure counts as black rather than poisoning
+            // the pixel's sum.
+            if (any(isnan(l)) || any(isinf(l))) {
+                l = vec3(0.0);
+            }
+            sum += vec4(l, 1.0);
+        }
+        if (push.samples_now > 0u) {
+            imageStore(path_sum, ivec2(pixel), sum);
+        }
+        imageStore(screen_radiance, ivec2(pixel), vec4(sum.a > 0.0 ? sum.rgb / sum.a : vec3(0.0), 1.0));
+    }
+    uint first;
+    SUBGROUP_ATOMIC_ADD(rays_cast, rays_here, first)
+}
