@@ -306,9 +306,10 @@ gpu_layout! {
 
         /// Path tracer (set 3, after the ray-casting bindings): `PathUniforms` uniform buffer.
         BINDING_PATH_UNIFORMS = 8;
-        /// Path tracer (set 3): the sum of the samples so far (rgb) and their count (a) per
-        /// pixel, `rgba32f` storage image.
-        BINDING_PATH_SUM = 9;
+        /// Path tracer (set 3): the mean of the samples so far (rgb) and their count (a) per
+        /// pixel, `rgba32f` storage image (a mean rather than a sum: a sum of a hundred
+        /// thousand samples in 32-bit floats loses the last digits that matter).
+        BINDING_PATH_MEAN = 9;
         /// Path tracer (set 3): rays cast since the counter was cleared, `uint[]` storage buffer
         /// (one word).
         BINDING_PATH_RAYS = 10;
@@ -709,7 +710,7 @@ gpu_layout! {
 
     /// Push constants of the path tracer: this dispatch's share of the samples.
     struct PathPush {
-        /// Samples already in `BINDING_PATH_SUM`: 0 starts the sum afresh.
+        /// Samples already in `BINDING_PATH_MEAN`: 0 starts afresh.
         uint samples_done,
         /// Samples each pixel takes in this dispatch (0: only the mean so far is written).
         uint samples_now,

@@ -417,8 +417,15 @@ impl App {
                 .iter()
                 .map(|(name, ms)| format!("{name} {ms:.1}"))
                 .collect();
+            let samples = viewer
+                .renderer
+                .gi()
+                .and_then(|t| t.progress())
+                .map_or_else(String::new, |p| {
+                    format!(", {}/{} samples per pixel", p.done, p.total)
+                });
             viewer.window.set_title(&format!(
-                "voxcone, {:.1} ms/frame dt, GPU ms: {}",
+                "voxcone, {:.1} ms/frame dt{samples}, GPU ms: {}",
                 dt * 1e3,
                 passes.join(" ")
             ));

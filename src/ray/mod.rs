@@ -72,6 +72,17 @@ const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::COMPUTE;
 /// The most triangles the BVHs hold (a leaf's first triangle has `RAY_LEAF_FIRST_BITS`).
 const MAX_TRIANGLES: usize = 1 << layout::RAY_LEAF_FIRST_BITS;
 
+/// Refuses a BVH deeper than the traversal stack holds (it pushes a node per level at most).
+fn check_depth(depth: u32, what: &str) -> Result<()> {
+    if depth >= layout::RAY_STACK_SIZE {
+        bail!(
+            "the {what} BVH is {depth} levels deep, more than the {} its traversal stack holds",
+            layout::RAY_STACK_SIZE
+        );
+    }
+    Ok(())
+}
+
 impl SceneRays {
     /// The set-3 bindings every ray-casting pass starts with.
     pub fn bindings() -> Vec<Binding> {
@@ -110,6 +121,7 @@ impl SceneRays {
         let statics = Triangles::of(scene, 0.0, |m| m.animation.is_none());
         let built = Bvh::build(&statics, 0, 0, false);
         let depth = built.depth;
+        check_depth(depth, "static meshes'")?;
         let stats = BuildStats {
             triangles: statics.len(),
             nodes: built.nodes.len(),
@@ -298,6 +310,7 @@ impl SceneRays {
         }
         let moving = Triangles::of(scene, time_s, |m| m.animation.is_some());
         let built = Bvh::build(&moving, self.static_nodes, self.static_triangles, true);
+        check_depth(built.depth, "moving meshes'")?;
         let parts: [&[u8]; 3] = [
             bytemuck::cast_slice(&built.nodes),
             bytemuck::cast_slice(&built.triangles),

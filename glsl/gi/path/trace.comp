@@ -6,8 +6,8 @@
 // coverage (and, under the references' conventions, stopping every shadow ray: the
 // references' next-event estimation ignores Mitsuba's masks), the scene's point, spot and
 // directional lights in the lighting pass's units, a constant sky, a box pixel filter,
-// Russian roulette from `rr_depth` on. Each invocation adds `samples_now` samples to its pixel's running sum
-// and writes the mean so far to the screen radiance.
+// Russian roulette from `rr_depth` on. Each invocation adds `samples_now` samples to its
+// pixel's running mean and writes it to the screen radiance.
 #include "common/direct_light.glsl"
 #include "common/random.glsl"
 #include "common/subgroup_add.glsl"
@@ -17,7 +17,7 @@ layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
 layout(set = SET_GI, binding = BINDING_PATH_UNIFORMS) uniform PathBlock {
     PathUniforms path;
 };
-layout(set = SET_GI, binding = BINDING_PATH_SUM, rgba32f) uniform image2D path_sum;
+layout(set = SET_GI, binding = BINDING_PATH_MEAN, rgba32f) uniform image2D path_mean;
 layout(set = SET_GI, binding = BINDING_PATH_RAYS, std430) buffer PathRayBlock {
     uint rays_cast;
 };
@@ -156,83 +156,119 @@ vec3 emitter_light(Surface s, vec3 origin, inout uint rng) {
     return s.albedo / PI * radiance * cos_s * weight / light_pdf;
 }
 
-// One path through `pixel`, its camera ray jittered over the pixel (a box filter).
-vec3 trace_path(uvec2 pixel, inout uint rng) {
-    vec2 at = (vec2(pixel) + vec2(random_next(rng), random_next(rng))) / vec2(frame.width, frame.height);
-    vec4 through = frame.inv_view_proj * vec4(at * 2.0 - 1.0, 0.5, 1.0);
-    vec3 origin = frame.camera_position.xyz;
-    vec3 dir = normalize(through.xyz / through.w - origin);
-    uint max_depth = path.max_depth == 0u ? 0xffffffffu : path.max_depth;
-    vec3 radiance = vec3(0.0);
-    vec3 throughput = vec3(1.0);
+// A path under way: where it goes next and what it has gathered.
+struct Path {
+    vec3 origin;
+    vec3 dir;
+    vec3 radiance;
+    vec3 throughput;
     // The density of the direction the path took last, 0 for the camera ray (whose hit
     // of an emitter no other technique samples).
-    float bsdf_pdf = 0.0;
-    for (uint depth = 1u;; depth++) {
-        Hit hit;
-        rays_here++;
-        if (!trace_closest(origin, dir, 0.0, 1e30, cut_seed(rng), hit)) {
-            radiance += throughput * frame.sky_radiance.rgb;
-            break;
-        }
-        Surface s = surface_at(hit, dir);
-        if (any(greaterThan(s.emitted, vec3(0.0)))) {
-            float weight = 1.0;
-            RayTriangle tri = ray_triangles[hit.triangle];
-            bool sampled = (floatBitsToUint(tri.e2.w) & RAY_MOVING) == 0u && rays.emitter_count > 0u;
-            if (bsdf_pdf > 0.0 && sampled) {
-                float largest = max(s.emitted.r, max(s.emitted.g, s.emitted.b));
-                weight = mis_weight(bsdf_pdf, emitter_pdf(largest, hit.t, dot(s.ng, -dir)));
-            }
-            radiance += throughput * s.emitted * weight;
-        }
-        if (depth >= max_depth) {
-            break;
-        }
-        vec3 from = s.p + s.ng * rays.epsilon;
-        radiance += throughput * (delta_lights(s, from, rng) + emitter_light(s, from, rng));
-        vec3 next = sample_cosine(s.ns, rng);
-        float cos_next = dot(s.ns, next);
-        if (cos_next <= 0.0 || dot(s.ng, next) <= 0.0) {
-            break;
-        }
-        throughput *= s.albedo;
-        bsdf_pdf = cos_next / PI;
-        if (depth >= path.rr_depth) {
-            float survive = min(max(throughput.r, max(throughput.g, throughput.b)), 0.95);
-            if (random_next(rng) >= survive) {
-                break;
-            }
-            throughput /= survive;
-        }
-        origin = from;
-        dir = next;
+    float bsdf_pdf;
+    // The vertex the next hit will be (1: the camera ray's).
+    uint depth;
+    uint rng;
+};
+
+// Sample `index` of `pixel`: its camera ray jittered over the pixel (a box filter).
+Path start_path(uvec2 pixel, uint index) {
+    Path p;
+    p.rng = random_seed(pixel, index, path.seed);
+    vec2 at = (vec2(pixel) + vec2(random_next(p.rng), random_next(p.rng))) / vec2(frame.width, frame.height);
+    vec4 through = frame.inv_view_proj * vec4(at * 2.0 - 1.0, 0.5, 1.0);
+    p.origin = frame.camera_position.xyz;
+    p.dir = normalize(through.xyz / through.w - p.origin);
+    p.radiance = vec3(0.0);
+    p.throughput = vec3(1.0);
+    p.bsdf_pdf = 0.0;
+    p.depth = 1u;
+    return p;
+}
+
+// Extends the path by one vertex; returns whether it goes on.
+bool extend(inout Path p) {
+    Hit hit;
+    rays_here++;
+    if (!trace_closest(p.origin, p.dir, 0.0, 1e30, cut_seed(p.rng), hit)) {
+        p.radiance += p.throughput * frame.sky_radiance.rgb;
+        return false;
     }
-    return radiance;
+    Surface s = surface_at(hit, p.dir);
+    if (any(greaterThan(s.emitted, vec3(0.0)))) {
+        float weight = 1.0;
+        RayTriangle tri = ray_triangles[hit.triangle];
+        bool sampled = (floatBitsToUint(tri.e2.w) & RAY_MOVING) == 0u && rays.emitter_count > 0u;
+        if (p.bsdf_pdf > 0.0 && sampled) {
+            float largest = max(s.emitted.r, max(s.emitted.g, s.emitted.b));
+            weight = mis_weight(p.bsdf_pdf, emitter_pdf(largest, hit.t, dot(s.ng, -p.dir)));
+        }
+        p.radiance += p.throughput * s.emitted * weight;
+    }
+    uint max_depth = path.max_depth == 0u ? 0xffffffffu : path.max_depth;
+    if (p.depth >= max_depth) {
+        return false;
+    }
+    vec3 from = s.p + s.ng * rays.epsilon;
+    p.radiance += p.throughput * (delta_lights(s, from, p.rng) + emitter_light(s, from, p.rng));
+    vec3 next = sample_cosine(s.ns, p.rng);
+    float cos_next = dot(s.ns, next);
+    if (cos_next <= 0.0 || dot(s.ng, next) <= 0.0) {
+        return false;
+    }
+    p.throughput *= s.albedo;
+    p.bsdf_pdf = cos_next / PI;
+    if (p.depth >= path.rr_depth) {
+        float survive = min(max(p.throughput.r, max(p.throughput.g, p.throughput.b)), 0.95);
+        if (random_next(p.rng) >= survive) {
+            return false;
+        }
+        p.throughput /= survive;
+    }
+    p.origin = from;
+    p.dir = next;
+    p.depth++;
+    return true;
 }
 
 void main() {
     uvec2 pixel = gl_GlobalInvocationID.xy;
     bool inside = pixel.x < frame.width && pixel.y < frame.height;
-    vec4 sum = vec4(0.0);
     if (inside) {
-        if (push.samples_done > 0u) {
-            sum = imageLoad(path_sum, ivec2(pixel));
-        }
-        for (uint i = 0u; i < push.samples_now; i++) {
-            uint rng = random_seed(pixel, push.samples_done + i, path.seed);
-            vec3 l = trace_path(pixel, rng);
-            // A sample lost to a numerical failure counts as black rather than poisoning
-            // the pixel's sum.
-            if (any(isnan(l)) || any(isinf(l))) {
-                l = vec3(0.0);
-            }
-            sum += vec4(l, 1.0);
-        }
+        vec4 mean = push.samples_done > 0u ? imageLoad(path_mean, ivec2(pixel)) : vec4(0.0);
+        vec3 batch = vec3(0.0);
+        // One loop over the vertices of all this pixel's samples, the next path started
+        // where one ends: neighbouring invocations run in SIMD lanes on a CPU driver, and
+        // a loop per sample would hold every lane until the longest path of each ended.
+        uint started = 0u;
+        Path p;
         if (push.samples_now > 0u) {
-            imageStore(path_sum, ivec2(pixel), sum);
+            p = start_path(pixel, push.samples_done);
+            started = 1u;
         }
-        imageStore(screen_radiance, ivec2(pixel), vec4(sum.a > 0.0 ? sum.rgb / sum.a : vec3(0.0), 1.0));
+        // The samples finished: a CPU driver may cut a long-running invocation's loops
+        // short (`PathTracer`'s batches), and a cut sample is not counted.
+        uint finished = 0u;
+        while (started > 0u) {
+            if (!extend(p)) {
+                // A sample lost to a numerical failure counts as black rather than
+                // poisoning the pixel's mean.
+                bool failed = any(isnan(p.radiance)) || any(isinf(p.radiance));
+                batch += failed ? vec3(0.0) : p.radiance;
+                finished++;
+                if (started == push.samples_now) {
+                    break;
+                }
+                p = start_path(pixel, push.samples_done + started);
+                started++;
+            }
+        }
+        if (finished > 0u) {
+            float n = float(finished);
+            float count = mean.a + n;
+            mean = vec4(mean.rgb + (batch - n * mean.rgb) / count, count);
+            imageStore(path_mean, ivec2(pixel), mean);
+        }
+        imageStore(screen_radiance, ivec2(pixel), vec4(mean.rgb, 1.0));
     }
     uint first;
     SUBGROUP_ATOMIC_ADD(rays_cast, rays_here, first)

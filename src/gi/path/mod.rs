@@ -4,9 +4,9 @@
 //!
 //! It casts its own camera rays through the scene ray caster ([`crate::ray`]): the frame
 //! draws no shadow maps and no G-buffer for it. Each frame adds a bounded number of
-//! samples per pixel to a running sum (no submission runs long enough for a GPU
-//! watchdog) and shows the mean so far; the sum starts again whenever the camera, a light
-//! or a mesh moves.
+//! samples per pixel to a running mean (no submission runs long enough for a GPU
+//! watchdog) and shows it; the mean starts again whenever the camera, a light or a mesh
+//! moves.
 
 pub mod cli;
 
@@ -35,7 +35,13 @@ pub const RR_DEPTH: u32 = 5;
 const PATHS_PER_FRAME: u32 = 1 << 18;
 
 /// Most samples per pixel a frame traces.
-const MAX_SAMPLES_PER_FRAME: u32 = 16;
+const MAX_SAMPLES_PER_FRAME: u32 = 1024;
+
+/// Most samples per pixel one dispatch traces on a CPU driver. Lavapipe ends every loop of
+/// an invocation once they have run about 65,535 iterations together (the furnace lost
+/// samples past a few hundred paths an invocation), so there each dispatch traces one
+/// path per pixel, which fits many times over; a frame then records several.
+const CPU_SAMPLES_PER_DISPATCH: u32 = 1;
 
 /// The path tracer's settings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,17 +95,19 @@ pub struct PathTracer {
     set: vk::DescriptorSet,
     _sets: DescriptorSets,
     _uniforms: Buffer,
-    /// The running sum of the samples and their count per pixel (screen-sized).
-    sum: Option<Image>,
+    /// The running mean of the samples and their count per pixel (screen-sized).
+    mean: Option<Image>,
     /// Rays cast by the last frame that traced samples (host-visible).
     rays_cast: Buffer,
-    /// Samples per pixel recorded into the sum so far.
+    /// Samples per pixel recorded into the mean so far.
     samples: u32,
     /// Samples a frame adds.
     per_frame: u32,
-    /// This frame's share of the samples.
-    push: PathPush,
-    /// What the sum was taken with (camera, lights, moving meshes), to start it again when
+    /// This frame's dispatches: their shares of the samples.
+    dispatches: Vec<PathPush>,
+    /// Samples one dispatch traces at most.
+    per_dispatch: u32,
+    /// What the mean was taken with (camera, lights, moving meshes), to start it again when
     /// that changes.
     view: Option<Vec<u8>>,
     extent: vk::Extent2D,
@@ -120,7 +128,7 @@ impl PathTracer {
                 compute,
             ),
             Binding::new(
-                layout::BINDING_PATH_SUM,
+                layout::BINDING_PATH_MEAN,
                 vk::DescriptorType::STORAGE_IMAGE,
                 compute,
             ),
@@ -180,11 +188,16 @@ impl PathTracer {
             set,
             _sets: sets,
             _uniforms: uniforms,
-            sum: None,
+            mean: None,
             rays_cast,
             samples: 0,
             per_frame: 1,
-            push: PathPush::default(),
+            dispatches: Vec::new(),
+            per_dispatch: if ctx.is_cpu() {
+                CPU_SAMPLES_PER_DISPATCH
+            } else {
+                MAX_SAMPLES_PER_FRAME
+            },
             view: None,
             extent: vk::Extent2D::default(),
             ctx: ctx.clone(),
@@ -220,11 +233,11 @@ impl Technique for PathTracer {
         Ok(())
     }
 
-    /// A new sum at the new size; the terms of the screen contract are unused.
+    /// A new mean at the new size; the terms of the screen contract are unused.
     fn bind_screen(&mut self, extent: vk::Extent2D) -> Result<ScreenRequest> {
-        let sum = Image::new(
+        let mean = Image::new(
             &self.ctx,
-            "path sum",
+            "path mean",
             ImageDesc::d2(
                 vk::Format::R32G32B32A32_SFLOAT,
                 extent.width,
@@ -232,22 +245,27 @@ impl Technique for PathTracer {
                 vk::ImageUsageFlags::STORAGE,
             ),
         )?;
-        to_compute_write(&self.ctx, "path sum layout", &[&sum])?;
+        to_compute_write(&self.ctx, "path mean layout", &[&mean])?;
         SetWriter::new(&self.ctx, self.set)
-            .storage_image(layout::BINDING_PATH_SUM, sum.view)
+            .storage_image(layout::BINDING_PATH_MEAN, mean.view)
             .apply();
-        self.sum = Some(sum);
+        self.mean = Some(mean);
         self.extent = extent;
         self.samples = 0;
         let pixels = (extent.width * extent.height).max(1);
-        self.per_frame = (PATHS_PER_FRAME / pixels).clamp(1, MAX_SAMPLES_PER_FRAME);
+        let most = if self.ctx.is_cpu() {
+            MAX_SAMPLES_PER_FRAME.min(256)
+        } else {
+            MAX_SAMPLES_PER_FRAME
+        };
+        self.per_frame = (PATHS_PER_FRAME / pixels).clamp(1, most);
         Ok(ScreenRequest {
             scale: 1,
             plane_tolerance: 1.0,
         })
     }
 
-    /// Takes this frame's share of the samples, the sum started again if the view
+    /// Takes this frame's share of the samples, the mean started again if the view
     /// changed; rebuilds the moving meshes' BVH.
     fn record_update(
         &mut self,
@@ -263,11 +281,17 @@ impl Technique for PathTracer {
         let now = self
             .per_frame
             .min(self.settings.spp.saturating_sub(self.samples));
-        self.push = PathPush {
-            samples_done: self.samples,
-            samples_now: now,
-            ..Default::default()
-        };
+        self.dispatches.clear();
+        let mut done = 0;
+        while done < now || self.dispatches.is_empty() {
+            let share = (now - done).min(self.per_dispatch);
+            self.dispatches.push(PathPush {
+                samples_done: self.samples + done,
+                samples_now: share,
+                ..Default::default()
+            });
+            done += share;
+        }
         self.samples += now;
         if now > 0 {
             // Counted afresh (a frame that traces nothing keeps the last count).
@@ -294,7 +318,7 @@ impl Technique for PathTracer {
             .record_moving(cmd, draw.scene, draw.time_s, frame.slot)
     }
 
-    /// Adds this frame's samples to the sum and writes the mean to the screen radiance.
+    /// Adds this frame's samples to the mean and writes it to the screen radiance.
     fn record_gather(
         &self,
         cmd: vk::CommandBuffer,
@@ -304,30 +328,32 @@ impl Technique for PathTracer {
         _options: &GatherOptions,
     ) -> Gathered {
         timer.begin(cmd, "path_trace");
-        // Last frame's trace wrote the sum this one adds to.
-        memory_barrier(
-            &self.ctx,
-            cmd,
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            ),
-        );
-        self.pipeline
-            .push(cmd, vk::ShaderStageFlags::COMPUTE, &self.push);
-        self.pipeline.dispatch(
-            cmd,
-            &[
-                (layout::SET_FRAME, frame_set),
-                (layout::SET_SCREEN, screen.set()),
-                (layout::SET_GI, self.set),
-            ],
-            groups_2d(self.extent, layout::SCREEN_GROUP_SIZE),
-        );
+        let sets = [
+            (layout::SET_FRAME, frame_set),
+            (layout::SET_SCREEN, screen.set()),
+            (layout::SET_GI, self.set),
+        ];
+        for push in &self.dispatches {
+            // The last dispatch (or frame) wrote the means this one adds to.
+            memory_barrier(
+                &self.ctx,
+                cmd,
+                (
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                ),
+            );
+            self.pipeline.push(cmd, vk::ShaderStageFlags::COMPUTE, push);
+            self.pipeline.dispatch(
+                cmd,
+                &sets,
+                groups_2d(self.extent, layout::SCREEN_GROUP_SIZE),
+            );
+        }
         // The ray count, read by the host once the frame is done.
         memory_barrier(
             &self.ctx,
@@ -353,7 +379,10 @@ impl Technique for PathTracer {
 
     fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
         let mut bytes = self.rays.memory_bytes();
-        bytes.push(("path_sum", self.sum.as_ref().map_or(0, Image::memory_bytes)));
+        bytes.push((
+            "path_mean",
+            self.mean.as_ref().map_or(0, Image::memory_bytes),
+        ));
         bytes
     }
 
