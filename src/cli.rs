@@ -278,7 +278,7 @@ impl CommonArgs {
                 GiSettings::ConeTracing(self.vct.settings(octree, scene)?)
             }
             GiMode::Path => {
-                let settings = self.path.settings(self.is_reference());
+                let settings = self.path.settings(scene, self.is_reference());
                 settings.check()?;
                 GiSettings::Path(settings)
             }

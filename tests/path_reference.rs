@@ -36,8 +36,9 @@ fn mean(image: &RgbImage) -> [f64; 3] {
 }
 
 /// A closed box, every wall of albedo `albedo` emitting radiance `emitted` inwards, with
-/// the camera inside: a scene file in `dir`.
-fn furnace(dir: &Path, albedo: f32, emitted: f32) -> PathBuf {
+/// the camera inside: a scene file in `dir`, with `gi` appended (a `[gi]` table, or
+/// nothing).
+fn furnace(dir: &Path, albedo: f32, emitted: f32, gi: &str) -> PathBuf {
     std::fs::write(
         dir.join("box.mtl"),
         format!("newmtl wall\nKd {albedo} {albedo} {albedo}\nKe {emitted} {emitted} {emitted}\n"),
@@ -51,8 +52,10 @@ fn furnace(dir: &Path, albedo: f32, emitted: f32) -> PathBuf {
     let scene = dir.join("furnace.toml");
     std::fs::write(
         &scene,
-        "[camera]\nposition = [0.5, 0.5, 0.5]\ntarget = [0.5, 0.5, 0.0]\nfov_y_deg = 90\n\
-         [[mesh]]\npath = \"box.obj\"\n",
+        format!(
+            "[camera]\nposition = [0.5, 0.5, 0.5]\ntarget = [0.5, 0.5, 0.0]\nfov_y_deg = 90\n\
+             [[mesh]]\npath = \"box.obj\"\n{gi}"
+        ),
     )
     .unwrap();
     scene
@@ -69,7 +72,7 @@ fn furnace_gives_the_geometric_series_at_every_pixel() {
     // well within the bound (0.16 %).
     for (albedo, spp) in [(0.5f32, "32768"), (0.8, "131072")] {
         let emitted = 0.5f32;
-        let scene = furnace(&dir, albedo, emitted);
+        let scene = furnace(&dir, albedo, emitted, "");
         let out = dir.join(format!("furnace_{albedo}.exr"));
         let image = render(&scene, &["--size", "2x2", "--spp", spp], &out);
         let expected = emitted / (1.0 - albedo);
@@ -81,6 +84,129 @@ fn furnace_gives_the_geometric_series_at_every_pixel() {
         eprintln!("albedo {albedo}: expected {expected}, worst pixel off by {worst:.4}");
         assert!(worst <= 0.005, "albedo {albedo}: a pixel is off by {worst}");
     }
+}
+
+/// Camera rays go where the projection puts the pixels: an emitting quad seen with
+/// `--max-depth 1` (emission only) whose edge crosses the middle of pixel column (or row)
+/// `EDGE` of 512 shows exactly half its radiance there. The edge sits 244 pixels from the
+/// centre, where a relative error of 1e-4 in the rays' slopes moves it by 0.024 pixels;
+/// 8 rows (or columns) of 1024 samples measure the coverage to 0.006 (one sigma).
+#[test]
+fn camera_rays_put_edges_where_the_projection_does() {
+    const LONG: u32 = 512;
+    const EDGE: u32 = 500;
+    let dir = temp_dir("path_camera_rays");
+    std::fs::write(dir.join("quad.mtl"), "newmtl glow\nKd 0 0 0\nKe 1 1 1\n").unwrap();
+    let distance = 5.0f64;
+    for vertical in [false, true] {
+        // The image is LONG pixels along the edge's normal and 8 along it; the view's
+        // vertical field is 2 degrees (wide images) or what gives the same slopes (tall).
+        let (width, height) = if vertical { (8, LONG) } else { (LONG, 8) };
+        let half_short = 1f64.to_radians().tan();
+        let half_long = half_short * f64::from(LONG) / 8.0;
+        let fov_y = 2.0
+            * if vertical { half_long } else { half_short }
+                .atan()
+                .to_degrees();
+        // The middle of pixel EDGE, in NDC, then on the quad's plane.
+        let ndc = (f64::from(EDGE) + 0.5) / f64::from(LONG) * 2.0 - 1.0;
+        let edge = ndc * half_long * distance;
+        let far = -1.2 * half_long * distance;
+        let side = 1.2 * half_short * distance;
+        // Wide: the quad covers x < edge (pixel columns grow with x). Tall: rows grow
+        // downwards, so row EDGE sees y = -edge, and the quad covers y > -edge (the rows
+        // above it).
+        let corners = if vertical {
+            [(-side, -edge), (side, -edge), (side, -far), (-side, -far)]
+        } else {
+            [(far, -side), (edge, -side), (edge, side), (far, side)]
+        };
+        let mut obj = String::from("mtllib quad.mtl\nusemtl glow\n");
+        for (x, y) in corners {
+            obj += &format!("v {x} {y} 0\n");
+        }
+        obj += "f 1 2 3 4\n";
+        std::fs::write(dir.join("quad.obj"), obj).unwrap();
+        let scene = dir.join("quad.toml");
+        std::fs::write(
+            &scene,
+            format!(
+                "[camera]\nposition = [0, 0, {distance}]\ntarget = [0, 0, 0]\nfov_y_deg = {fov_y}\n\
+                 [[mesh]]\npath = \"quad.obj\"\n"
+            ),
+        )
+        .unwrap();
+        let size = format!("{width}x{height}");
+        let out = dir.join(format!("edge_{vertical}.exr"));
+        let image = render(
+            &scene,
+            &["--size", &size, "--spp", "1024", "--max-depth", "1"],
+            &out,
+        );
+        let at = |x: u32, y: u32| image.data[((y * width + x) * 3) as usize];
+        let line: Vec<f32> = (0..8)
+            .map(|i| if vertical { at(i, EDGE) } else { at(EDGE, i) })
+            .collect();
+        let coverage = line.iter().sum::<f32>() / 8.0;
+        let (inside, outside) = if vertical {
+            (at(0, EDGE - 1), at(0, EDGE + 1))
+        } else {
+            (at(EDGE - 1, 0), at(EDGE + 1, 0))
+        };
+        eprintln!("vertical {vertical}: coverage of the edge's pixels {coverage:.4}");
+        assert!(
+            (inside, outside) == (1.0, 0.0),
+            "neighbours {inside}, {outside}"
+        );
+        assert!(
+            (coverage - 0.5).abs() < 0.02,
+            "vertical {vertical}: the edge's pixels are {coverage} covered, not 0.5: {line:?}"
+        );
+    }
+}
+
+/// The scene file's `[gi]` table sets the samples and the path length, and the command
+/// line wins: in the furnace (a = 0.5, L = 0.5) paths of one vertex see only the walls'
+/// emission, L exactly, and paths of three L (1 + a + a^2).
+#[test]
+fn scene_file_sets_the_path_length() {
+    let dir = temp_dir("path_scene_file");
+    let (albedo, emitted) = (0.5f32, 0.5f32);
+    let scene = furnace(&dir, albedo, emitted, "[gi]\nspp = 4096\nmax_depth = 1\n");
+    let cases = [
+        ("depth1.exr", &[][..], emitted),
+        (
+            "depth3.exr",
+            &["--max-depth", "3"][..],
+            emitted * (1.0 + albedo + albedo * albedo),
+        ),
+    ];
+    for (name, extra, expected) in cases {
+        let mut args = vec!["--size", "2x2"];
+        args.extend_from_slice(extra);
+        let image = render(&scene, &args, &dir.join(name));
+        for &v in &image.data {
+            assert!(
+                (v / expected - 1.0).abs() < 0.01,
+                "{name}: {v}, expected {expected}"
+            );
+        }
+    }
+    let zero = furnace(&dir, albedo, emitted, "[gi]\nspp = 0\n");
+    let output = voxcone(&[
+        "render",
+        zero.to_str().unwrap(),
+        "--gi",
+        "path",
+        "-o",
+        dir.join("zero.exr").to_str().unwrap(),
+    ]);
+    assert!(!output.status.success(), "spp = 0 was accepted");
+    assert!(
+        stderr(&output).contains("--spp must be at least 1"),
+        "{}",
+        stderr(&output)
+    );
 }
 
 /// The same seed gives the same image, bit for bit; another seed other noise with the same

@@ -59,6 +59,8 @@
 //! shadow_cones = false           # --shadow-cones
 //! shadow_aperture_deg = 4.0      # --shadow-aperture
 //! ao_distance_voxels = 4.0       # --ao-distance
+//! spp = 256                      # --spp (--gi path)
+//! max_depth = 2                  # --max-depth (--gi path): 2 is direct light only
 //! ```
 //!
 //! `spin` turns about the centre of the entry's object-space bounds at `deg_per_s`;

@@ -4,11 +4,12 @@
 //! `scenes_root`), `camera.{pos, target, up, fov_y_deg}`, `lights.point[].{position,
 //! intensity_W_sr}`, `lights.directional[].{direction_of_travel, irradiance_W_m2}`,
 //! `lights.env_radiance` (null or RGB), `lights.mtl_emission` (false sets the emission scale
-//! to 0) and `lights.emission_scale`. Other keys are ignored.
+//! to 0), `lights.emission_scale` and `flags.max_depth` (the path tracer's longest path:
+//! -1 for no limit). Other keys are ignored.
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{ensure, Context as _, Result};
+use anyhow::{bail, ensure, Context as _, Result};
 use glam::{Mat4, Vec3};
 use serde::Deserialize;
 
@@ -22,6 +23,14 @@ struct ReferenceScene {
     obj: PathBuf,
     camera: ReferenceCamera,
     lights: ReferenceLights,
+    #[serde(default)]
+    flags: ReferenceFlags,
+}
+
+/// How the reference was integrated: the longest path (-1: no limit, 2: direct light).
+#[derive(Deserialize, Default)]
+struct ReferenceFlags {
+    max_depth: Option<i64>,
 }
 
 #[derive(Deserialize)]
@@ -127,10 +136,16 @@ fn scene_from_reference(
         emission_scale,
         animation: None,
     };
+    let max_depth = match spec.flags.max_depth {
+        None | Some(-1) => None,
+        Some(depth @ 1..=1024) => Some(depth as u32),
+        Some(other) => bail!("flags.max_depth must be -1 (no limit) or 1 to 1024, got {other}"),
+    };
     let mut scene = load_geometry(&[entry], options, source)?;
     scene.camera = camera;
     scene.lights = lights;
     scene.sky = sky;
+    scene.gi.max_depth = max_depth;
     Ok(scene)
 }
 
@@ -154,6 +169,7 @@ mod tests {
         let scene = Scene::load(&dir.0.join("ref/q.scene.json"), &LoadOptions::default()).unwrap();
         assert_eq!(scene.materials[0].emission, Vec3::new(4.0, 6.0, 8.0));
         assert_eq!(scene.sky, Vec3::new(0.1, 0.2, 0.3));
+        assert_eq!(scene.gi.max_depth, None, "no flags: no limit");
         assert_eq!(
             scene.lights[0].kind,
             LightKind::Directional {
@@ -161,6 +177,14 @@ mod tests {
             }
         );
         assert_eq!(scene.lights[0].intensity, Vec3::new(1.0, 2.0, 3.0));
+
+        let deep = json.replace("}}", "}, \"flags\": {\"max_depth\": 5000}}");
+        std::fs::write(dir.0.join("ref/deep.scene.json"), deep).unwrap();
+        let message = error_text(Scene::load(
+            &dir.0.join("ref/deep.scene.json"),
+            &LoadOptions::default(),
+        ));
+        assert!(message.contains("flags.max_depth must be -1"), "{message}");
 
         let broken = dir.write("broken.scene.json", "{\"obj\": 3}");
         let message = error_text(Scene::load(&broken, &LoadOptions::default()));
@@ -193,6 +217,11 @@ mod tests {
             "mtl_emission false"
         );
         assert_eq!(scene.sky, Vec3::ZERO);
+        assert_eq!(
+            scene.gi.max_depth,
+            Some(2),
+            "flags.max_depth: direct light only"
+        );
         let b = scene.bounds(0.0);
         assert!(b.min.abs_diff_eq(Vec3::new(-1.0, 0.0, -1.0), 0.05), "{b:?}");
         assert!(b.max.abs_diff_eq(Vec3::new(1.0, 2.0, 1.0), 0.05), "{b:?}");

@@ -175,9 +175,14 @@ Path start_path(uvec2 pixel, uint index) {
     Path p;
     p.rng = random_seed(pixel, index, path.seed);
     vec2 at = (vec2(pixel) + vec2(random_next(p.rng), random_next(p.rng))) / vec2(frame.width, frame.height);
-    vec4 through = frame.inv_view_proj * vec4(at * 2.0 - 1.0, 0.5, 1.0);
+    // From the projection's focal lengths and the view's rotation, not by unprojecting a
+    // point through inv_view_proj: that point lies a few near-plane distances (a
+    // thousandth of the scene) from the eye, and in 32 bits it scaled the Cornell box's
+    // image by 1.5e-4 against Mitsuba's, a 3 % error along the light's sharp edge.
+    vec2 ndc = at * 2.0 - 1.0;
+    vec3 view_dir = vec3(ndc.x / frame.proj[0][0], ndc.y / frame.proj[1][1], -1.0);
     p.origin = frame.camera_position.xyz;
-    p.dir = normalize(through.xyz / through.w - p.origin);
+    p.dir = normalize(transpose(mat3(frame.view)) * view_dir);
     p.radiance = vec3(0.0);
     p.throughput = vec3(1.0);
     p.bsdf_pdf = 0.0;

@@ -3,15 +3,16 @@
 use clap::Args;
 
 use super::PathSettings;
+use crate::scene::GiOverrides;
 
 #[derive(Args, Debug, Clone)]
 pub struct PathArgs {
-    /// `--gi path`: samples per pixel [default: 256].
+    /// `--gi path`: samples per pixel [default: the scene file's, else 256].
     #[arg(long)]
     pub spp: Option<u32>,
     /// `--gi path`: the longest path, in vertices from the camera (as Mitsuba's
-    /// max_depth): 2 is direct light only, 3 adds one bounce [default: no limit, Russian
-    /// roulette from depth 5].
+    /// max_depth): 2 is direct light only, 3 adds one bounce [default: the scene file's,
+    /// else no limit, Russian roulette from depth 5].
     #[arg(long)]
     pub max_depth: Option<u32>,
     /// `--gi path`: seed of the random sequences (another seed: other noise, the same
@@ -33,13 +34,14 @@ impl PathArgs {
         .collect()
     }
 
-    /// The path tracer's settings: the command line over the defaults; `reference`: the
-    /// scene is a path-traced reference's, whose conventions the settings follow.
-    pub fn settings(&self, reference: bool) -> PathSettings {
+    /// The path tracer's settings: the command line over the scene file's over the
+    /// defaults; `reference`: the scene is a path-traced reference's, whose conventions the
+    /// settings follow.
+    pub fn settings(&self, scene: &GiOverrides, reference: bool) -> PathSettings {
         let d = PathSettings::default();
         PathSettings {
-            spp: self.spp.unwrap_or(d.spp),
-            max_depth: self.max_depth,
+            spp: self.spp.or(scene.spp).unwrap_or(d.spp),
+            max_depth: self.max_depth.or(scene.max_depth),
             seed: self.seed.unwrap_or(d.seed),
             opaque_shadow_cut_outs: reference,
         }
