@@ -4,25 +4,13 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-
-use common::{assert_clean, shared, stderr, temp_dir, voxcone};
+use common::{furnace, render_path as render, shared, stderr, temp_dir, voxcone, FURNACE_CAMERA};
 use voxcone::compare::{compare, CompareOptions};
 use voxcone::imageio::{load_rgb, RgbImage};
 
-/// Renders `scene` with `--gi path` and `extra` to `out` (EXR), validation clean.
-fn render(scene: &Path, extra: &[&str], out: &Path) -> RgbImage {
-    let mut args = vec![
-        "render",
-        scene.to_str().unwrap(),
-        "--gi",
-        "path",
-        "-o",
-        out.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    assert_clean(&voxcone(&args));
-    load_rgb(out).unwrap().0
+/// The furnace's walls: Lambertian of albedo `albedo`, emitting `emitted`.
+fn diffuse_walls(albedo: f32, emitted: f32) -> String {
+    format!("Kd {albedo} {albedo} {albedo}\nKe {emitted} {emitted} {emitted}\n")
 }
 
 fn mean(image: &RgbImage) -> [f64; 3] {
@@ -33,32 +21,6 @@ fn mean(image: &RgbImage) -> [f64; 3] {
         }
     }
     sum.map(|s| s / (image.data.len() / 3) as f64)
-}
-
-/// A closed box, every wall of albedo `albedo` emitting radiance `emitted` inwards, with
-/// the camera inside: a scene file in `dir`, with `gi` appended (a `[gi]` table, or
-/// nothing).
-fn furnace(dir: &Path, albedo: f32, emitted: f32, gi: &str) -> PathBuf {
-    std::fs::write(
-        dir.join("box.mtl"),
-        format!("newmtl wall\nKd {albedo} {albedo} {albedo}\nKe {emitted} {emitted} {emitted}\n"),
-    )
-    .unwrap();
-    // A unit cube whose faces wind towards its inside (their normals point in).
-    let obj = "mtllib box.mtl\nusemtl wall\n\
-        v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
-        f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n";
-    std::fs::write(dir.join("box.obj"), obj).unwrap();
-    let scene = dir.join("furnace.toml");
-    std::fs::write(
-        &scene,
-        format!(
-            "[camera]\nposition = [0.5, 0.5, 0.5]\ntarget = [0.5, 0.5, 0.0]\nfov_y_deg = 90\n\
-             [[mesh]]\npath = \"box.obj\"\n{gi}"
-        ),
-    )
-    .unwrap();
-    scene
 }
 
 /// The white furnace: a closed box of albedo a emitting L everywhere shows L / (1 - a) at
@@ -72,7 +34,7 @@ fn furnace_gives_the_geometric_series_at_every_pixel() {
     // well within the bound (0.16 %).
     for (albedo, spp) in [(0.5f32, "32768"), (0.8, "131072")] {
         let emitted = 0.5f32;
-        let scene = furnace(&dir, albedo, emitted, "");
+        let scene = furnace(&dir, &diffuse_walls(albedo, emitted), FURNACE_CAMERA);
         let out = dir.join(format!("furnace_{albedo}.exr"));
         let image = render(&scene, &["--size", "2x2", "--spp", spp], &out);
         let expected = emitted / (1.0 - albedo);
@@ -172,7 +134,11 @@ fn camera_rays_put_edges_where_the_projection_does() {
 fn scene_file_sets_the_path_length() {
     let dir = temp_dir("path_scene_file");
     let (albedo, emitted) = (0.5f32, 0.5f32);
-    let scene = furnace(&dir, albedo, emitted, "[gi]\nspp = 4096\nmax_depth = 1\n");
+    let scene = furnace(
+        &dir,
+        &diffuse_walls(albedo, emitted),
+        &format!("{FURNACE_CAMERA}[gi]\nspp = 4096\nmax_depth = 1\n"),
+    );
     let cases = [
         ("depth1.exr", &[][..], emitted),
         (
@@ -192,7 +158,11 @@ fn scene_file_sets_the_path_length() {
             );
         }
     }
-    let zero = furnace(&dir, albedo, emitted, "[gi]\nspp = 0\n");
+    let zero = furnace(
+        &dir,
+        &diffuse_walls(albedo, emitted),
+        &format!("{FURNACE_CAMERA}[gi]\nspp = 0\n"),
+    );
     let output = voxcone(&[
         "render",
         zero.to_str().unwrap(),

@@ -1,7 +1,7 @@
 // Scene ray casting (`src/ray/`): the first bindings of a set 3 that casts rays. Two BVH2s
 // over the scene's triangles (the static meshes', built once, and the moving meshes',
 // built every frame), traversed here: the closest hit, or any hit for visibility. Cut-out
-// materials (map_d, d < 1) let rays through where their coverage is below one half, as
+// materials (map_d; d < 1 where the light passes straight) let rays through where their coverage is below one half, as
 // the shadow maps and voxels count them; or, for a ray given a `cut_seed`, with the
 // probability 1 - coverage, as the path-traced references' Mitsuba masks do, or never
 // (`RAY_OPAQUE`: the references' shadow rays ignore the masks).
@@ -82,8 +82,14 @@ vec2 triangle_uv(uint i, vec2 bary) {
     return uv0 * (1.0 - bary.x - bary.y) + uv1 * bary.x + uv2 * bary.y;
 }
 
+// Whether light passing a material bends (d < 1, Ni > 1; `Material::refracts`): its
+// d is then left to the shading, which refracts the light that passes.
+bool material_refracts(GpuMaterial m) {
+    return m.albedo.a < 1.0 && m.emission.a > 1.0;
+}
+
 // Whether triangle `i`, hit at `bary`, lets the ray through: a cut-out material with its
-// coverage (d x map_d) below one half there (`cut_seed` 0), below a number drawn for this
+// coverage (d x map_d, map_d alone where it refracts) below one half there (`cut_seed` 0), below a number drawn for this
 // ray and triangle (another seed), or never (`RAY_OPAQUE`).
 bool cut_out(uint i, vec2 bary, uint cut_seed) {
     RayTriangle tri = ray_triangles[i];
@@ -91,7 +97,7 @@ bool cut_out(uint i, vec2 bary, uint cut_seed) {
         return false;
     }
     GpuMaterial m = ray_materials[floatBitsToUint(tri.v0.w)];
-    float coverage = m.albedo.a;
+    float coverage = material_refracts(m) ? 1.0 : m.albedo.a;
     if (m.coverage_texture != NO_TEXTURE) {
         coverage *= texture_bilinear(m.coverage_texture, triangle_uv(i, bary), false).r;
     }

@@ -30,7 +30,8 @@ impl Triangles {
                 continue;
             }
             let material = &scene.materials[mesh.material as usize];
-            let cut_out = material.coverage_texture.is_some() || material.dissolve < 1.0;
+            let cut_out = material.coverage_texture.is_some()
+                || (material.dissolve < 1.0 && !material.refracts());
             let flags = u32::from(cut_out) * layout::RAY_CUT_OUT
                 + u32::from(mesh.animation.is_some()) * layout::RAY_MOVING;
             let transform = scene.mesh_transform(m, time_s);
@@ -79,9 +80,9 @@ pub struct Bvh {
 
 impl Bvh {
     /// The BVH of `triangles`, to sit at node `node_offset` and triangle `triangle_offset`
-    /// of the GPU's buffers (its indices point there), laid out for stackless traversal
-    /// (every node followed by its first child, with an escape index: a stack per lane
-    /// costs a CPU driver's SIMD lanes more than the ordered traversal it allows saves).
+    /// of the GPU's buffers (its indices point there), laid out depth first: every inner
+    /// node is followed by its first child, and the second child sits at the first's
+    /// escape index, so a node's children are found from one read.
     /// `fast`: a quicker build of lower quality, for what is rebuilt every frame.
     pub fn build(
         triangles: &Triangles,

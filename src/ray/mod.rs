@@ -83,6 +83,20 @@ fn check_depth(depth: u32, what: &str) -> Result<()> {
     Ok(())
 }
 
+/// Refuses a buffer of `size` bytes beyond `limit`, the most the device binds in one
+/// storage buffer (`maxStorageBufferRange`), naming both.
+fn check_buffer_size(name: &str, size: u64, limit: u64) -> Result<()> {
+    if size > limit {
+        bail!(
+            "the scene's {name} need {size} bytes ({:.1} MiB), more than the {limit} bytes \
+             ({:.1} MiB) the device binds in one storage buffer",
+            size as f64 / 1048576.0,
+            limit as f64 / 1048576.0
+        );
+    }
+    Ok(())
+}
+
 impl SceneRays {
     /// The set-3 bindings every ray-casting pass starts with.
     pub fn bindings() -> Vec<Binding> {
@@ -145,13 +159,11 @@ impl SceneRays {
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
         let sized = |name: &str, element: usize, count: u32, data: &[u8]| -> Result<Buffer> {
             let size = (element as u64 * u64::from(count)).max(16);
-            let limit = u64::from(ctx.properties.limits.max_storage_buffer_range);
-            if size > limit {
-                bail!(
-                    "the scene's {name} need {size} bytes, more than the {limit} the device binds \
-                     in one storage buffer"
-                );
-            }
+            check_buffer_size(
+                name,
+                size,
+                u64::from(ctx.properties.limits.max_storage_buffer_range),
+            )?;
             let mut bytes = data.to_vec();
             bytes.resize(size as usize, 0);
             upload_buffer(ctx, &one_shot, name, &bytes, usage)

@@ -7,7 +7,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::query::RayQueries;
-use super::{SceneRays, Triangles};
+use super::{check_buffer_size, SceneRays, Triangles};
 use crate::gpu_layout::{RayHit, RayQuery, RAY_ANY, RAY_CLOSEST, RAY_NONE};
 use crate::scene::testing::{shared_file, TempDir};
 use crate::scene::{LoadOptions, Scene};
@@ -75,14 +75,19 @@ impl Twin<'_> {
     }
 
     /// Whether triangle `i` lets the ray through at (u, v): coverage (d x map_d, bilinear
-    /// with wrap-around, as `texture_bilinear`) below one half.
+    /// with wrap-around, as `texture_bilinear`; map_d alone where the material refracts)
+    /// below one half.
     fn cut_out(&self, i: usize, u: f32, v: f32) -> bool {
         let tri = &self.triangles.triangles[i];
         if tri.e2[3].to_bits() & crate::gpu_layout::RAY_CUT_OUT == 0 {
             return false;
         }
         let material = &self.scene.materials[tri.v0[3].to_bits() as usize];
-        let mut coverage = material.dissolve;
+        let mut coverage = if material.refracts() {
+            1.0
+        } else {
+            material.dissolve
+        };
         if let Some(t) = material.coverage_texture {
             let s = &self.triangles.shading[i];
             let uv0 = [s.n0[3], s.n1[3]];
@@ -400,4 +405,24 @@ fn cut_outs_pass_rays_where_coverage_is_below_one_half() {
         }
     }
     assert_eq!(ctx.validation_messages(), 0);
+}
+
+/// A scene whose buffers the device cannot bind is refused with the sizes named (a scene
+/// with more triangles than a storage buffer's range holds is too slow to write and load
+/// in a test, so the check is tested on its own).
+#[test]
+fn a_buffer_beyond_the_device_limit_is_refused_with_its_size() {
+    let limit = 1u64 << 27;
+    assert!(check_buffer_size("ray triangles", limit, limit).is_ok());
+    let error = check_buffer_size("ray triangles", limit + 16, limit)
+        .unwrap_err()
+        .to_string();
+    for part in [
+        "ray triangles",
+        "134217744 bytes",
+        "134217728 bytes",
+        "128.0 MiB",
+    ] {
+        assert!(error.contains(part), "{error:?} lacks {part:?}");
+    }
 }

@@ -153,6 +153,14 @@ impl Material {
             ior: 1.0,
         }
     }
+
+    /// Whether light passing the surface bends (d < 1 and Ni > 1): ray casting then counts
+    /// only map_d as a cut-out and leaves the 1 - d that passes to the shading, which
+    /// refracts it. With Ni = 1 the light passes straight, as through a cut-out of
+    /// coverage d.
+    pub fn refracts(&self) -> bool {
+        self.dissolve < 1.0 && self.ior > 1.0
+    }
 }
 
 /// How to load a scene.

@@ -100,6 +100,15 @@ impl Pipeline {
         }
     }
 
+    /// Dispatches `groups` workgroups of this compute pipeline, bound earlier with its sets.
+    pub fn dispatch_bound(&self, cmd: vk::CommandBuffer, groups: [u32; 3]) {
+        unsafe {
+            self.ctx
+                .device
+                .cmd_dispatch(cmd, groups[0], groups[1], groups[2])
+        };
+    }
+
     /// Binds this compute pipeline and `sets`, then dispatches `groups` workgroups.
     pub fn dispatch(
         &self,

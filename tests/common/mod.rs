@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use voxcone::imageio::{load_rgb, RgbImage};
 
 /// `../shared` beside the repository, or `None` (with the reason printed) when absent.
 pub fn shared() -> Option<PathBuf> {
@@ -58,16 +59,44 @@ pub fn assert_clean(output: &Output) {
     );
 }
 
-/// Renders `scene` at 256x256 to `out` with the options `extra`, validation clean.
-pub fn render_256(scene: &Path, extra: &[&str], out: &Path) {
+/// Renders `scene` to `out` with the options `options`, validation clean.
+pub fn render(scene: &Path, options: &[&str], out: &Path) {
     let mut args = vec![
         "render",
         scene.to_str().unwrap(),
-        "--size",
-        "256x256",
         "-o",
         out.to_str().unwrap(),
     ];
-    args.extend_from_slice(extra);
+    args.extend_from_slice(options);
     assert_clean(&voxcone(&args));
+}
+
+/// Renders `scene` at 256x256 to `out` with the options `extra`, validation clean.
+pub fn render_256(scene: &Path, extra: &[&str], out: &Path) {
+    render(scene, &[&["--size", "256x256"], extra].concat(), out);
+}
+
+/// Renders `scene` with `--gi path` and `extra` to `out` (EXR), validation clean.
+pub fn render_path(scene: &Path, extra: &[&str], out: &Path) -> RgbImage {
+    render(scene, &[&["--gi", "path"], extra].concat(), out);
+    load_rgb(out).unwrap().0
+}
+
+/// The camera at the furnace's centre, looking at its -Z wall with a 90 degree view.
+pub const FURNACE_CAMERA: &str =
+    "[camera]\nposition = [0.5, 0.5, 0.5]\ntarget = [0.5, 0.5, 0.0]\nfov_y_deg = 90\n";
+
+/// A closed unit box whose every wall has the MTL statements `walls` (each emitting
+/// inwards where they give Ke), as a scene file in `dir` with `extra` appended (its
+/// `[camera]`, such as `FURNACE_CAMERA`, and a `[gi]` table where it has one).
+pub fn furnace(dir: &Path, walls: &str, extra: &str) -> PathBuf {
+    std::fs::write(dir.join("box.mtl"), format!("newmtl wall\n{walls}")).unwrap();
+    // A unit cube whose faces wind towards its inside (their normals point in).
+    let obj = "mtllib box.mtl\nusemtl wall\n\
+        v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+        f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n";
+    std::fs::write(dir.join("box.obj"), obj).unwrap();
+    let scene = dir.join("furnace.toml");
+    std::fs::write(&scene, format!("[[mesh]]\npath = \"box.obj\"\n{extra}")).unwrap();
+    scene
 }

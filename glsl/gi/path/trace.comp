@@ -1,7 +1,9 @@
 #version 460
 // The path-traced reference (`--gi path`): a unidirectional path tracer with next-event
 // estimation and multiple importance sampling (Veach 1997), as the references' Mitsuba 3
-// integrator: two-sided Lambertian surfaces of albedo Kd x map_Kd, one-sided emitters
+// integrator: two-sided surfaces of albedo Kd x map_Kd (Lambertian, plus the lighting
+// pass's normalised Blinn-Phong lobe where Ks > 0, with its normal maps), transmissive
+// surfaces (d < 1) passing 1 - d of the light refracted by Ni, one-sided emitters
 // (MTL Ke, along the winding normal), cut-outs passing rays with the probability 1 -
 // coverage (and, under the references' conventions, stopping every shadow ray: the
 // references' next-event estimation ignores Mitsuba's masks), the scene's point, spot and
@@ -34,12 +36,47 @@ struct Surface {
     vec3 p;
     // The geometric normal on the side the ray came from.
     vec3 ng;
-    // The shading normal, turned to that side too (two-sided shading).
+    // The shading normal, turned to that side too (two-sided shading), normal-mapped.
     vec3 ns;
+    // Towards the ray's origin.
+    vec3 v;
     vec3 albedo;
+    // The lighting pass's specular weight (mean Ks) and roughness (from Ns).
+    float specular;
+    float roughness;
+    // The share of light passing a refracting surface (1 - d; 0 elsewhere) and the
+    // relative index of refraction along the ray (Ni entering the front, 1 / Ni leaving).
+    float transmit;
+    float eta;
     // Emitted radiance towards the ray's origin (zero from the back of an emitter).
     vec3 emitted;
 };
+
+// The shading normal `n` perturbed by tangent-space normal map `map` of triangle `i` at
+// `uv`, in the G-buffer's cotangent frame (Schüler) with the triangle's edges for the
+// screen-space derivatives: both give the same frame, the edges exactly. The sign of
+// n . (e1 x e2) keeps the frame the gradients of u and v from the back side too.
+vec3 apply_normal_map(uint i, vec3 n, uint map, vec2 uv) {
+    RayTriangle tri = ray_triangles[i];
+    RayShading sh = ray_shading[i];
+    vec2 uv0 = vec2(sh.n0.w, sh.n1.w);
+    vec2 duv1 = vec2(sh.n2.w, sh.uv.x) - uv0;
+    vec2 duv2 = sh.uv.yz - uv0;
+    vec3 dp2perp = cross(tri.e2.xyz, n);
+    vec3 dp1perp = cross(n, tri.e1.xyz);
+    vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
+    vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
+    float len = max(dot(t, t), dot(b, b));
+    if (len < 1e-30) {
+        return n;
+    }
+    float scale = dot(n, cross(tri.e1.xyz, tri.e2.xyz)) < 0.0 ? -inversesqrt(len) : inversesqrt(len);
+    vec3 m = texture_bilinear(map, uv, false).xyz * 2.0 - 1.0;
+    // Our v runs down the image, the map's green axis up it (as the G-buffer).
+    m.y = -m.y;
+    vec3 mapped = normalize(mat3(t * scale, b * scale, n) * m);
+    return any(isnan(mapped)) ? n : mapped;
+}
 
 Surface surface_at(Hit hit, vec3 dir) {
     RayTriangle tri = ray_triangles[hit.triangle];
@@ -54,10 +91,19 @@ Surface surface_at(Hit hit, vec3 dir) {
     vec3 ns = sh.n0.xyz * w + sh.n1.xyz * hit.bary.x + sh.n2.xyz * hit.bary.y;
     ns = dot(ns, ns) > 1e-12 ? normalize(ns) : s.ng;
     s.ns = dot(ns, s.ng) < 0.0 ? -ns : ns;
+    vec2 uv = triangle_uv(hit.triangle, hit.bary);
+    if (m.normal_texture != NO_TEXTURE) {
+        s.ns = apply_normal_map(hit.triangle, s.ns, m.normal_texture, uv);
+    }
+    s.v = -dir;
     s.albedo = m.albedo.rgb;
     if (m.albedo_texture != NO_TEXTURE) {
-        s.albedo *= texture_bilinear(m.albedo_texture, triangle_uv(hit.triangle, hit.bary), true).rgb;
+        s.albedo *= texture_bilinear(m.albedo_texture, uv, true).rgb;
     }
+    s.specular = dot(m.specular.rgb, vec3(1.0 / 3.0));
+    s.roughness = m.specular.a;
+    s.transmit = material_refracts(m) ? 1.0 - m.albedo.a : 0.0;
+    s.eta = front ? m.emission.a : 1.0 / m.emission.a;
     s.emitted = front ? m.emission.rgb : vec3(0.0);
     return s;
 }
@@ -77,6 +123,60 @@ vec3 sample_cosine(vec3 n, inout uint rng) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);
     return normalize(r * cos(phi) * t + r * sin(phi) * b + sqrt(max(1.0 - r * r, 0.0)) * n);
+}
+
+// The Blinn-Phong exponent of the lighting pass's lobe for `roughness`.
+float phong_exponent(float roughness) {
+    float r = max(roughness, 0.02);
+    return 2.0 / (r * r) - 2.0;
+}
+
+// The probability of sampling the specular lobe rather than the cosine at `s`: the
+// lobe's share of the two weights.
+float lobe_choice(Surface s) {
+    float diffuse = dot(s.albedo, vec3(1.0 / 3.0));
+    return s.specular > 0.0 ? s.specular / (s.specular + diffuse) : 0.0;
+}
+
+// The density of direction `l` under the sampling of `sample_bsdf` at `s`: cos / pi
+// mixed with the Blinn-Phong half-vector density (e + 1) / (2 pi) cos^e(theta_h),
+// carried to `l` by 1 / (4 v.h).
+float bsdf_pdf(Surface s, vec3 l) {
+    float cos_l = dot(s.ns, l);
+    if (cos_l <= 0.0) {
+        return 0.0;
+    }
+    float pdf = cos_l / PI;
+    float lobe = lobe_choice(s);
+    if (lobe > 0.0) {
+        float e = phong_exponent(s.roughness);
+        vec3 h = normalize(l + s.v);
+        float vh = max(dot(s.v, h), 1e-6);
+        float lobe_pdf = (e + 1.0) / (2.0 * PI) * pow(max(dot(s.ns, h), 0.0), e) / (4.0 * vh);
+        pdf = mix(pdf, lobe_pdf, lobe);
+    }
+    return pdf;
+}
+
+// A direction from `s` for the next vertex, by `lobe_choice`: the cosine or a half-vector
+// about the shading normal from the Blinn-Phong lobe, the view mirrored about it.
+vec3 sample_bsdf(Surface s, inout uint rng) {
+    if (random_next(rng) >= lobe_choice(s)) {
+        return sample_cosine(s.ns, rng);
+    }
+    float e = phong_exponent(s.roughness);
+    float cos_h = pow(random_next(rng), 1.0 / (e + 1.0));
+    float sin_h = sqrt(max(1.0 - cos_h * cos_h, 0.0));
+    float phi = 6.2831853 * random_next(rng);
+    vec3 t = normalize(abs(s.ns.y) < 0.9 ? cross(s.ns, vec3(0.0, 1.0, 0.0)) : cross(s.ns, vec3(1.0, 0.0, 0.0)));
+    vec3 b = cross(s.ns, t);
+    vec3 h = sin_h * cos(phi) * t + sin_h * sin(phi) * b + cos_h * s.ns;
+    return reflect(-s.v, h);
+}
+
+// The BRDF at `s` for light arriving from `l`: the lighting pass's `surface_brdf`.
+vec3 brdf(Surface s, vec3 l) {
+    return surface_brdf(s.albedo, s.specular, s.roughness, s.ns, s.v, l);
 }
 
 // The density, in solid angle at a point `dist` away, with which next-event estimation
@@ -115,7 +215,7 @@ vec3 delta_lights(Surface s, vec3 origin, inout uint rng) {
         }
         float reach = lights[i].kind == LIGHT_DIRECTIONAL ? 1e30 : dist - 2.0 * rays.epsilon;
         if (visible(origin, l, reach, rng)) {
-            sum += s.albedo / PI * e * cos_s;
+            sum += brdf(s, l) * e * cos_s;
         }
     }
     return sum;
@@ -152,8 +252,8 @@ vec3 emitter_light(Surface s, vec3 origin, inout uint rng) {
     }
     vec3 radiance = ray_materials[floatBitsToUint(tri.v0.w)].emission.rgb;
     float light_pdf = emitter_pdf(max(radiance.r, max(radiance.g, radiance.b)), dist, cos_light);
-    float weight = mis_weight(light_pdf, cos_s / PI);
-    return s.albedo / PI * radiance * cos_s * weight / light_pdf;
+    float weight = mis_weight(light_pdf, bsdf_pdf(s, l));
+    return brdf(s, l) * radiance * cos_s * weight / light_pdf;
 }
 
 // A path under way: where it goes next and what it has gathered.
@@ -190,6 +290,20 @@ Path start_path(uvec2 pixel, uint index) {
     return p;
 }
 
+// Russian roulette from `rr_depth` on: whether the path goes on, its throughput raised
+// by the chance it had.
+bool survives(inout Path p) {
+    if (p.depth < path.rr_depth) {
+        return true;
+    }
+    float survive = min(max(p.throughput.r, max(p.throughput.g, p.throughput.b)), 0.95);
+    if (random_next(p.rng) >= survive) {
+        return false;
+    }
+    p.throughput /= survive;
+    return true;
+}
+
 // Extends the path by one vertex; returns whether it goes on.
 bool extend(inout Path p) {
     Hit hit;
@@ -213,21 +327,30 @@ bool extend(inout Path p) {
     if (p.depth >= max_depth) {
         return false;
     }
+    if (s.transmit > 0.0 && random_next(p.rng) < s.transmit) {
+        // The light passing the surface, refracted (reflected where it cannot leave):
+        // a direction no other technique samples, so an emitter it reaches counts whole.
+        vec3 bent = refract(p.dir, s.ng, 1.0 / s.eta);
+        bool through = dot(bent, bent) > 0.0;
+        p.dir = through ? normalize(bent) : reflect(p.dir, s.ng);
+        p.origin = s.p + (through ? -s.ng : s.ng) * rays.epsilon;
+        p.bsdf_pdf = 0.0;
+        bool goes_on = survives(p);
+        p.depth++;
+        return goes_on;
+    }
     vec3 from = s.p + s.ng * rays.epsilon;
     p.radiance += p.throughput * (delta_lights(s, from, p.rng) + emitter_light(s, from, p.rng));
-    vec3 next = sample_cosine(s.ns, p.rng);
+    vec3 next = sample_bsdf(s, p.rng);
     float cos_next = dot(s.ns, next);
-    if (cos_next <= 0.0 || dot(s.ng, next) <= 0.0) {
+    float pdf = bsdf_pdf(s, next);
+    if (cos_next <= 0.0 || dot(s.ng, next) <= 0.0 || pdf <= 0.0) {
         return false;
     }
-    p.throughput *= s.albedo;
-    p.bsdf_pdf = cos_next / PI;
-    if (p.depth >= path.rr_depth) {
-        float survive = min(max(p.throughput.r, max(p.throughput.g, p.throughput.b)), 0.95);
-        if (random_next(p.rng) >= survive) {
-            return false;
-        }
-        p.throughput /= survive;
+    p.throughput *= brdf(s, next) * cos_next / pdf;
+    p.bsdf_pdf = pdf;
+    if (!survives(p)) {
+        return false;
     }
     p.origin = from;
     p.dir = next;

@@ -16,7 +16,10 @@ layout(location = 3) out vec2 out_transmission; // transmittance (1 - d), index 
 #ifdef NORMAL_MAPS
 // Perturbs n by a tangent-space normal map with a cotangent frame from screen-space
 // derivatives (Schüler, "Normal mapping without precomputed tangents"), so meshes need
-// no tangents.
+// no tangents. The frame's two vectors are the gradients of u and v only up to the sign
+// of n . (dp1 x dp2), which the normalisation drops: with Vulkan's framebuffer y running
+// down, a surface facing the camera has it negative, and without the sign the map's
+// tilts came out mirrored (the path tracer, which takes the triangle's edges, showed it).
 vec3 apply_normal_map(vec3 n) {
     vec3 dp1 = dFdx(in_world);
     vec3 dp2 = dFdy(in_world);
@@ -30,7 +33,7 @@ vec3 apply_normal_map(vec3 n) {
     if (len < 1e-20) {
         return n;
     }
-    float scale = inversesqrt(len);
+    float scale = dot(n, cross(dp1, dp2)) < 0.0 ? -inversesqrt(len) : inversesqrt(len);
     vec3 m = texture(normal_texture, in_uv).xyz * 2.0 - 1.0;
     // Our v runs down the image (Vertex.uv), the map's green axis runs up it.
     m.y = -m.y;
