@@ -210,6 +210,37 @@ fn seeds_decide_the_noise_and_not_the_mean() {
     }
 }
 
+/// A render of several frames prints its estimate after the first, before the rest, and
+/// its progress as it goes: 1024
+/// samples per pixel at 32x32 take 4 frames of 256 samples (2^18 paths a frame).
+#[test]
+fn render_prints_its_estimate_first() {
+    let dir = temp_dir("path_estimate");
+    let out = dir.join("x.exr");
+    let scene = voxcone::cli::default_scene();
+    let output = voxcone(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--gi",
+        "path",
+        "--size",
+        "32x32",
+        "--spp",
+        "1024",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    common::assert_clean(&output);
+    let err = stderr(&output);
+    let estimate = err
+        .find("4 frames to render, about ")
+        .unwrap_or_else(|| panic!("no estimate: {err}"));
+    // Without a terminal the progress bar logs each quarter instead.
+    let progress = err.find("256 of 1024 samples per pixel").unwrap();
+    let rendered = err.find("rendered 32x32 (1024 samples per pixel)").unwrap();
+    assert!(estimate < progress && progress < rendered, "{err}");
+}
+
 /// Settings the path tracer cannot take, and its options without it, are refused with the
 /// reason, before any GPU work.
 #[test]

@@ -431,6 +431,13 @@ impl App {
             ));
         }
         if last {
+            if let Some(p) = viewer.renderer.gi().and_then(|t| t.progress()) {
+                log::info!(
+                    "the last frame showed {} of {} samples per pixel",
+                    p.done,
+                    p.total
+                );
+            }
             event_loop.exit();
         }
     }

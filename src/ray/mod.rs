@@ -41,6 +41,10 @@ pub struct BuildStats {
     pub build_ms: f64,
     /// The longest path from the root to a leaf.
     pub depth: u32,
+    /// The moving meshes' triangles, and the host time of their last rebuild (gathered,
+    /// transformed, built and flattened; 0 without moving meshes).
+    pub moving_triangles: usize,
+    pub moving_build_ms: f64,
 }
 
 /// The scene's triangles on the GPU, ready to cast rays against.
@@ -141,6 +145,8 @@ impl SceneRays {
             nodes: built.nodes.len(),
             build_ms: start.elapsed().as_secs_f64() * 1e3,
             depth,
+            moving_triangles: 0,
+            moving_build_ms: 0.0,
         };
         log::info!(
             "ray casting: BVH of {} static triangles, {} nodes, {depth} levels, built in {:.0} ms",
@@ -320,9 +326,12 @@ impl SceneRays {
         if !self.has_moving_meshes() {
             return Ok(());
         }
+        let start = Instant::now();
         let moving = Triangles::of(scene, time_s, |m| m.animation.is_some());
         let built = Bvh::build(&moving, self.static_nodes, self.static_triangles, true);
         check_depth(built.depth, "moving meshes'")?;
+        self.stats.moving_triangles = moving.len();
+        self.stats.moving_build_ms = start.elapsed().as_secs_f64() * 1e3;
         let parts: [&[u8]; 3] = [
             bytemuck::cast_slice(&built.nodes),
             bytemuck::cast_slice(&built.triangles),

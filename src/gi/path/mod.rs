@@ -399,6 +399,8 @@ impl Technique for PathTracer {
             ("bvh_nodes".into(), s.nodes as f64),
             ("bvh_depth".into(), f64::from(s.depth)),
             ("bvh_build_ms".into(), s.build_ms),
+            ("moving_bvh_triangles".into(), s.moving_triangles as f64),
+            ("moving_bvh_build_ms".into(), s.moving_build_ms),
         ])
     }
 
