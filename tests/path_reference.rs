@@ -163,14 +163,7 @@ fn scene_file_sets_the_path_length() {
         &diffuse_walls(albedo, emitted),
         &format!("{FURNACE_CAMERA}[gi]\nspp = 0\n"),
     );
-    let output = voxcone(&[
-        "render",
-        zero.to_str().unwrap(),
-        "--gi",
-        "path",
-        "-o",
-        dir.join("zero.exr").to_str().unwrap(),
-    ]);
+    let output = common::run_render(&zero, &["--gi", "path"], &dir.join("zero.exr"));
     assert!(!output.status.success(), "spp = 0 was accepted");
     assert!(
         stderr(&output).contains("--spp must be at least 1"),
@@ -211,25 +204,18 @@ fn seeds_decide_the_noise_and_not_the_mean() {
 }
 
 /// A render of several frames prints its estimate after the first, before the rest, and
-/// its progress as it goes: 1024
-/// samples per pixel at 32x32 take 4 frames of 256 samples (2^18 paths a frame).
+/// its progress as it goes: 1024 samples per pixel at 32x32 take 4 frames of 256 samples
+/// (2^18 paths a frame).
 #[test]
 fn render_prints_its_estimate_first() {
     let dir = temp_dir("path_estimate");
     let out = dir.join("x.exr");
     let scene = voxcone::cli::default_scene();
-    let output = voxcone(&[
-        "render",
-        scene.to_str().unwrap(),
-        "--gi",
-        "path",
-        "--size",
-        "32x32",
-        "--spp",
-        "1024",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let output = common::run_render(
+        &scene,
+        &["--gi", "path", "--size", "32x32", "--spp", "1024"],
+        &out,
+    );
     common::assert_clean(&output);
     let err = stderr(&output);
     let estimate = err

@@ -59,8 +59,8 @@ pub fn assert_clean(output: &Output) {
     );
 }
 
-/// Renders `scene` to `out` with the options `options`, validation clean.
-pub fn render(scene: &Path, options: &[&str], out: &Path) {
+/// Runs `voxcone render scene -o out` with the options `options`, validation on.
+pub fn run_render(scene: &Path, options: &[&str], out: &Path) -> Output {
     let mut args = vec![
         "render",
         scene.to_str().unwrap(),
@@ -68,7 +68,12 @@ pub fn render(scene: &Path, options: &[&str], out: &Path) {
         out.to_str().unwrap(),
     ];
     args.extend_from_slice(options);
-    assert_clean(&voxcone(&args));
+    voxcone(&args)
+}
+
+/// Renders `scene` to `out` with the options `options`, validation clean.
+pub fn render(scene: &Path, options: &[&str], out: &Path) {
+    assert_clean(&run_render(scene, options, out));
 }
 
 /// Renders `scene` at 256x256 to `out` with the options `extra`, validation clean.
