@@ -253,27 +253,30 @@ gpu_layout! {
         /// Scene ray casting (the first bindings of a set 3 that casts rays,
         /// `glsl/ray/rays.glsl`): `RayUniforms` uniform buffer.
         BINDING_RAY_UNIFORMS = 0;
-        /// Ray casting (set 3): the BVHs' nodes, `BvhNode[]` storage buffer: the static
-        /// meshes' BVH from node 0, the moving meshes' after it (`RayUniforms.moving_root`),
-        /// each depth first with escape indices, for traversal without a stack.
+        /// Ray casting (set 3): the BVHs' nodes, `BvhNode`s as a `usamplerBuffer` of five
+        /// texels each: the static meshes' BVH from node 0, the moving meshes' after it
+        /// (`RayUniforms.moving_root`), each node's inner children contiguous.
         BINDING_RAY_NODES = 1;
-        /// Ray casting (set 3): the triangles in the BVHs' leaf order, `RayTriangle[]` storage
-        /// buffer: a vertex, two edges and the material, as the intersection test reads them.
+        /// Ray casting (set 3): the triangles in the BVHs' leaf order, `RayTriangle`s as a
+        /// `usamplerBuffer` of three texels each: a vertex, two edges and the material, as
+        /// the intersection test reads them.
         BINDING_RAY_TRIANGLES = 2;
-        /// Ray casting (set 3): the triangles' shading attributes, `RayShading[]` storage
-        /// buffer, in the same order.
+        /// Ray casting (set 3): the triangles' shading attributes, `RayShading`s as a
+        /// `usamplerBuffer` of four texels each, in the same order.
         BINDING_RAY_SHADING = 3;
-        /// Ray casting (set 3): the scene's materials, `GpuMaterial[]` storage buffer.
+        /// Ray casting (set 3): the scene's materials, `GpuMaterial`s as a `usamplerBuffer` of
+        /// four texels each.
         BINDING_RAY_MATERIALS = 4;
         /// Ray casting (set 3): every scene texture's full-resolution level in one atlas,
         /// `sampler2D` read with `texelFetch` (filtered in the shader: dynamic indexing of
         /// texture arrays is an optional feature that lavapipe lacks); albedo sRGB-encoded.
         BINDING_RAY_ATLAS = 5;
-        /// Ray casting (set 3): where each texture lies in the atlas, `uvec4[]` storage buffer
-        /// (x, y, width, height in texels).
+        /// Ray casting (set 3): where each texture lies in the atlas, a `usamplerBuffer` of a
+        /// texel each (x, y, width, height in texels).
         BINDING_RAY_TEXTURES = 6;
-        /// Ray casting (set 3): the emissive triangles for next-event estimation, `RayEmitter[]`
-        /// storage buffer, sampled by power through their cumulative distribution.
+        /// Ray casting (set 3): the emissive triangles for next-event estimation, `RayEmitter`s
+        /// as a `usamplerBuffer` of a texel each, sampled by power through their cumulative
+        /// distribution.
         BINDING_RAY_EMITTERS = 7;
         /// A BVH node index meaning "none" (`RayUniforms.moving_root` without moving meshes),
         /// and a triangle index meaning "no hit".
@@ -284,11 +287,8 @@ gpu_layout! {
         /// `RayTriangle.e2.w` bit: a moving mesh's (not among the emitters next-event
         /// estimation samples).
         RAY_MOVING = 2;
-        /// Bits of a leaf's first triangle in `BvhNode.max_leaf`: the BVHs hold fewer than 2^24
-        /// triangles.
-        RAY_LEAF_FIRST_BITS = 24;
-        /// Entries of the traversal stack: one per level at most (Sponza's BVH has 37).
-        RAY_STACK_SIZE = 64;
+        /// Entries of the traversal stack: one group of children per level at most.
+        RAY_STACK_SIZE = 32;
         /// Workgroup size of the batched ray queries.
         RAY_GROUP_SIZE = 64;
         /// A cut-out seed (`glsl/ray/rays.glsl`) for rays that cut-outs stop whatever their
@@ -606,12 +606,18 @@ gpu_layout! {
         ivec4 region_max,
     }
 
-    /// A node of a BVH2 over triangles, depth first: an inner node's first child follows it, and every node's escape is the node after its subtree (`RAY_NONE` after the last), where traversal goes on after missing its box or testing its leaf.
+    /// A node of a compressed wide BVH (CWBVH, Ylitie et al. 2017; obvhs's `CwBvhNode`, byte for byte): eight children, their boxes quantized to bytes in the node's frame.
     struct BvhNode {
-        /// xyz bounds' minimum, w the escape (the bits of a uint).
-        vec4 min_escape,
-        /// xyz bounds' maximum, w 0 for an inner node, for a leaf its first triangle in the low `RAY_LEAF_FIRST_BITS` bits and their count above (the bits of a uint).
-        vec4 max_leaf,
+        /// xyz the frame's origin (the node's box minimum, float bits); w the frame's scale per axis as three exponent bytes, then the mask of the children that are inner nodes.
+        uvec4 origin_scale,
+        /// x the first inner child's node, y the first triangle of the children's leaves, zw the children's eight meta bytes (an inner child's slot + 24 with the bits 001 above; a leaf's first triangle, relative to y, with its count in unary above).
+        uvec4 children,
+        /// The children's quantized box bounds in x: eight minimum bytes (xy), eight maximum bytes (zw).
+        uvec4 bounds_x,
+        /// The same in y.
+        uvec4 bounds_y,
+        /// The same in z.
+        uvec4 bounds_z,
     }
 
     /// A triangle as the intersection test reads it.

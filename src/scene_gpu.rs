@@ -170,6 +170,23 @@ fn texture_index(index: Option<u32>) -> u32 {
     index.unwrap_or(layout::NO_TEXTURE)
 }
 
+/// The scene's materials as the shaders read them, in the scene's order.
+pub fn gpu_materials(scene: &Scene) -> Vec<GpuMaterial> {
+    scene
+        .materials
+        .iter()
+        .map(|m| GpuMaterial {
+            albedo: m.albedo.extend(m.dissolve).to_array(),
+            specular: m.specular.extend(m.roughness).to_array(),
+            emission: m.emission.extend(m.ior).to_array(),
+            albedo_texture: texture_index(m.albedo_texture),
+            coverage_texture: texture_index(m.coverage_texture),
+            normal_texture: texture_index(m.normal_texture),
+            pad: 0,
+        })
+        .collect()
+}
+
 impl GpuScene {
     pub fn bindings() -> [Binding; 4] {
         let stages = vk::ShaderStageFlags::ALL;
@@ -220,19 +237,7 @@ impl GpuScene {
             bytemuck::cast_slice(&indices),
             index_usage,
         )?;
-        let gpu_materials: Vec<GpuMaterial> = scene
-            .materials
-            .iter()
-            .map(|m| GpuMaterial {
-                albedo: m.albedo.extend(m.dissolve).to_array(),
-                specular: m.specular.extend(m.roughness).to_array(),
-                emission: m.emission.extend(m.ior).to_array(),
-                albedo_texture: texture_index(m.albedo_texture),
-                coverage_texture: texture_index(m.coverage_texture),
-                normal_texture: texture_index(m.normal_texture),
-                pad: 0,
-            })
-            .collect();
+        let gpu_materials = gpu_materials(scene);
         let materials = upload_buffer(
             ctx,
             &one_shot,

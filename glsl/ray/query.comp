@@ -28,7 +28,7 @@ void main() {
     } else {
         Hit hit;
         if (trace_closest(q.origin_tmin.xyz, q.direction_tmax.xyz, q.origin_tmin.w, q.direction_tmax.w, 0u, hit)) {
-            answer = RayHit(floatBitsToUint(ray_triangles[hit.triangle].e1.w), hit.t, hit.bary.x, hit.bary.y);
+            answer = RayHit(floatBitsToUint(ray_triangle(hit.triangle).e1.w), hit.t, hit.bary.x, hit.bary.y);
         }
     }
     hits[i] = answer;

@@ -1,10 +1,11 @@
-// Scene ray casting (`src/ray/`): the first bindings of a set 3 that casts rays. Two BVH2s
-// over the scene's triangles (the static meshes', built once, and the moving meshes',
-// built every frame), traversed here: the closest hit, or any hit for visibility. Cut-out
-// materials (map_d; d < 1 where the light passes straight) let rays through where their coverage is below one half, as
-// the shadow maps and voxels count them; or, for a ray given a `cut_seed`, with the
-// probability 1 - coverage, as the path-traced references' Mitsuba masks do, or never
-// (`RAY_OPAQUE`: the references' shadow rays ignore the masks).
+// Scene ray casting (`src/ray/`): the first bindings of a set 3 that casts rays. Two
+// compressed eight-wide BVHs (CWBVH) over the scene's triangles (the static meshes',
+// built once, and the moving meshes', built every frame), traversed here: the closest
+// hit, or any hit for visibility. Cut-out materials (map_d; d < 1 where the light passes
+// straight) let rays through where their coverage is below one half, as the shadow maps
+// and voxels count them; or, for a ray given a `cut_seed`, with the probability
+// 1 - coverage, as the path-traced references' Mitsuba masks do, or never (`RAY_OPAQUE`:
+// the references' shadow rays ignore the masks).
 #ifndef RAYS_GLSL
 #define RAYS_GLSL
 #include "gpu_layout.glsl"
@@ -13,27 +14,55 @@
 layout(set = SET_GI, binding = BINDING_RAY_UNIFORMS) uniform RayBlock {
     RayUniforms rays;
 };
-layout(set = SET_GI, binding = BINDING_RAY_NODES, std430) readonly buffer RayNodeBlock {
-    BvhNode bvh_nodes[];
-};
-layout(set = SET_GI, binding = BINDING_RAY_TRIANGLES, std430) readonly buffer RayTriangleBlock {
-    RayTriangle ray_triangles[];
-};
-layout(set = SET_GI, binding = BINDING_RAY_SHADING, std430) readonly buffer RayShadingBlock {
-    RayShading ray_shading[];
-};
-layout(set = SET_GI, binding = BINDING_RAY_MATERIALS, std430) readonly buffer RayMaterialBlock {
-    GpuMaterial ray_materials[];
-};
+// Every buffer rays read is a texel buffer, each struct a few uvec4 texels: traversal
+// reads them at every step, and a CPU driver fetches texels for all SIMD lanes at once,
+// where it loads a storage buffer one lane and one word at a time (Mesa's gallivm
+// bounds-checks each); GPUs cache texel fetches well too (Aila & Laine 2009).
+layout(set = SET_GI, binding = BINDING_RAY_NODES) uniform usamplerBuffer ray_node_texels;
+layout(set = SET_GI, binding = BINDING_RAY_TRIANGLES) uniform usamplerBuffer ray_triangle_texels;
+layout(set = SET_GI, binding = BINDING_RAY_SHADING) uniform usamplerBuffer ray_shading_texels;
+layout(set = SET_GI, binding = BINDING_RAY_MATERIALS) uniform usamplerBuffer ray_material_texels;
 layout(set = SET_GI, binding = BINDING_RAY_ATLAS) uniform sampler2D texture_atlas;
-layout(set = SET_GI, binding = BINDING_RAY_TEXTURES, std430) readonly buffer RayTextureBlock {
-    uvec4 texture_rects[];
-};
-layout(set = SET_GI, binding = BINDING_RAY_EMITTERS, std430) readonly buffer RayEmitterBlock {
-    RayEmitter emitters[];
-};
+layout(set = SET_GI, binding = BINDING_RAY_TEXTURES) uniform usamplerBuffer texture_rects;
+layout(set = SET_GI, binding = BINDING_RAY_EMITTERS) uniform usamplerBuffer ray_emitter_texels;
 
-// Where a ray met a triangle: the triangle (in `ray_triangles`), the distance, and the
+GpuMaterial ray_material(uint i) {
+    int at = int(4u * i);
+    uvec4 textures = texelFetch(ray_material_texels, at + 3);
+    return GpuMaterial(uintBitsToFloat(texelFetch(ray_material_texels, at)),
+                       uintBitsToFloat(texelFetch(ray_material_texels, at + 1)),
+                       uintBitsToFloat(texelFetch(ray_material_texels, at + 2)), textures.x,
+                       textures.y, textures.z, textures.w);
+}
+
+RayEmitter ray_emitter(uint i) {
+    uvec4 texel = texelFetch(ray_emitter_texels, int(i));
+    return RayEmitter(texel.x, uintBitsToFloat(texel.y), texel.z, texel.w);
+}
+
+BvhNode bvh_node(uint i) {
+    int at = int(5u * i);
+    return BvhNode(texelFetch(ray_node_texels, at), texelFetch(ray_node_texels, at + 1),
+                   texelFetch(ray_node_texels, at + 2), texelFetch(ray_node_texels, at + 3),
+                   texelFetch(ray_node_texels, at + 4));
+}
+
+RayTriangle ray_triangle(uint i) {
+    int at = int(3u * i);
+    return RayTriangle(uintBitsToFloat(texelFetch(ray_triangle_texels, at)),
+                       uintBitsToFloat(texelFetch(ray_triangle_texels, at + 1)),
+                       uintBitsToFloat(texelFetch(ray_triangle_texels, at + 2)));
+}
+
+RayShading ray_shading(uint i) {
+    int at = int(4u * i);
+    return RayShading(uintBitsToFloat(texelFetch(ray_shading_texels, at)),
+                      uintBitsToFloat(texelFetch(ray_shading_texels, at + 1)),
+                      uintBitsToFloat(texelFetch(ray_shading_texels, at + 2)),
+                      uintBitsToFloat(texelFetch(ray_shading_texels, at + 3)));
+}
+
+// Where a ray met a triangle: the triangle (its index for `ray_triangle`), the distance, and the
 // barycentric coordinates of its second and third vertices.
 struct Hit {
     uint triangle;
@@ -56,7 +85,7 @@ vec3 srgb_to_linear(vec3 c) {
 // Texture `index` at `uv`, bilinear between texel centres, wrapping around; sRGB-decoded
 // before the blend where `srgb` (albedo), as hardware sampling of an sRGB image does.
 vec4 texture_bilinear(uint index, vec2 uv, bool srgb) {
-    uvec4 rect = texture_rects[index];
+    uvec4 rect = texelFetch(texture_rects, int(index));
     vec2 at = uv * vec2(rect.zw) - 0.5;
     ivec2 base = ivec2(floor(at));
     vec2 f = at - vec2(base);
@@ -75,7 +104,7 @@ vec4 texture_bilinear(uint index, vec2 uv, bool srgb) {
 
 // The uv of triangle `i` at barycentric coordinates `bary`.
 vec2 triangle_uv(uint i, vec2 bary) {
-    RayShading s = ray_shading[i];
+    RayShading s = ray_shading(i);
     vec2 uv0 = vec2(s.n0.w, s.n1.w);
     vec2 uv1 = vec2(s.n2.w, s.uv.x);
     vec2 uv2 = s.uv.yz;
@@ -89,19 +118,23 @@ bool material_refracts(GpuMaterial m) {
 }
 
 // Whether triangle `i`, hit at `bary`, lets the ray through: a cut-out material with its
-// coverage (d x map_d, map_d alone where it refracts) below one half there (`cut_seed` 0), below a number drawn for this
-// ray and triangle (another seed), or never (`RAY_OPAQUE`).
+// coverage (d x map_d, map_d alone where it refracts) below one half there (`cut_seed`
+// 0), below a number drawn for this ray and triangle (another seed), or never
+// (`RAY_OPAQUE`).
 bool cut_out(uint i, vec2 bary, uint cut_seed) {
-    RayTriangle tri = ray_triangles[i];
+    RayTriangle tri = ray_triangle(i);
     if ((floatBitsToUint(tri.e2.w) & RAY_CUT_OUT) == 0u || cut_seed == RAY_OPAQUE) {
         return false;
     }
-    GpuMaterial m = ray_materials[floatBitsToUint(tri.v0.w)];
+    GpuMaterial m = ray_material(floatBitsToUint(tri.v0.w));
     float coverage = material_refracts(m) ? 1.0 : m.albedo.a;
     if (m.coverage_texture != NO_TEXTURE) {
         coverage *= texture_bilinear(m.coverage_texture, triangle_uv(i, bary), false).r;
     }
-    float threshold = cut_seed == 0u ? 0.5 : float(pcg_hash(cut_seed ^ i) >> 8u) * (1.0 / 16777216.0);
+    // Drawn for the triangle's index in the scene, not in the BVH's leaf order: the same
+    // decisions whatever the BVH's build (the moving meshes' is rebuilt every frame).
+    uint scene_index = floatBitsToUint(tri.e1.w);
+    float threshold = cut_seed == 0u ? 0.5 : float(pcg_hash(cut_seed ^ scene_index) >> 8u) * (1.0 / 16777216.0);
     return coverage < threshold;
 }
 
@@ -133,98 +166,113 @@ bool intersect_triangle(RayTriangle tri, vec3 origin, vec3 dir, float tmin, floa
     return t > tmin && t < tmax;
 }
 
-// The distance at which the ray enters box `n` within (tmin, tmax) (slab test), infinity
-// where it does not.
-float enter_box(BvhNode n, vec3 origin, vec3 inv_dir, float tmin, float tmax) {
-    vec3 lo = (n.min_escape.xyz - origin) * inv_dir;
-    vec3 hi = (n.max_leaf.xyz - origin) * inv_dir;
-    vec3 near = min(lo, hi);
-    vec3 far = max(lo, hi);
-    float enter = max(max(near.x, near.y), max(near.z, tmin));
-    float leave = min(min(far.x, far.y), min(far.z, tmax));
-    return enter <= leave ? enter : uintBitsToFloat(0x7f800000u);
+// The ray's octant, a bit per axis where the direction is not negative, in each byte:
+// it orders a node's children near to far (obvhs orders each node's slots by octant).
+uint octant_inv4(vec3 dir) {
+    return (dir.x < 0.0 ? 0u : 0x04040404u) | (dir.y < 0.0 ? 0u : 0x02020202u) |
+           (dir.z < 0.0 ? 0u : 0x01010101u);
 }
 
-// Walks the BVH rooted at `root`, the nearer child first (an inner node's first child
-// follows it, and its second is the node after the first's subtree: the first's
-// escape), the farther ones on a stack: the closest hit before `hit.t` (which it lowers),
-// or with `any`, the first one found. Returns whether it found one.
+// Byte `k` of the eight in `pair`.
+uint byte_of(uvec2 pair, uint k) {
+    return ((k < 4u ? pair.x : pair.y) >> (8u * (k & 3u))) & 0xffu;
+}
+
+// The children of node `n` the ray enters within (tmin, tmax), as the CWBVH traversal
+// takes them (Ylitie et al. 2017, obvhs's `CwBvhNode::intersect_ray`): for an inner child
+// a bit in the top byte, at its slot + 24 permuted by the octant (higher: nearer); for a
+// leaf its triangles' bits in the low 24, from its first one's offset. The quantized
+// boxes enclose the exact ones, so no hit is lost.
+uint intersect_children(BvhNode n, vec3 origin, vec3 inv_dir, float tmin, float tmax, uint oct_inv4) {
+    uvec3 exponents = (uvec3(n.origin_scale.w) >> uvec3(0u, 8u, 16u)) & 0xffu;
+    vec3 scale = uintBitsToFloat(exponents << 23u) * inv_dir;
+    vec3 shift = (uintBitsToFloat(n.origin_scale.xyz) - origin) * inv_dir;
+    bvec3 negative = lessThan(inv_dir, vec3(0.0));
+    uint hits = 0u;
+    for (uint part = 0u; part < 2u; part++) {
+        uint meta4 = part == 0u ? n.children.z : n.children.w;
+        // An inner child's meta byte is 001 then its slot + 24: the only bytes with both
+        // bits 4 and 3 set.
+        uint inner4 = ((meta4 & (meta4 << 1u)) & 0x10101010u) >> 4u;
+        uint bit_index4 = (meta4 ^ (oct_inv4 & (inner4 * 0xffu))) & 0x1f1f1f1fu;
+        uint child_bits4 = (meta4 >> 5u) & 0x07070707u;
+        for (uint j = 0u; j < 4u; j++) {
+            uint k = 4u * part + j;
+            vec3 lo = vec3(byte_of(n.bounds_x.xy, k), byte_of(n.bounds_y.xy, k), byte_of(n.bounds_z.xy, k));
+            vec3 hi = vec3(byte_of(n.bounds_x.zw, k), byte_of(n.bounds_y.zw, k), byte_of(n.bounds_z.zw, k));
+            vec3 near = mix(lo, hi, negative) * scale + shift;
+            vec3 far = mix(hi, lo, negative) * scale + shift;
+            float enter = max(max(near.x, near.y), max(near.z, tmin));
+            float leave = min(min(far.x, far.y), min(far.z, tmax));
+            if (enter <= leave) {
+                uint shift_by = 8u * j;
+                hits |= ((child_bits4 >> shift_by) & 0xffu) << ((bit_index4 >> shift_by) & 0xffu);
+            }
+        }
+    }
+    return hits;
+}
+
+// Walks the CWBVH rooted at `root` (obvhs's `traverse!`): a group is a node's children
+// the ray enters (x: the first inner child, y: their hit bits and the inner mask), taken
+// nearest first; the rest of a group waits on the stack while one child is walked. The
+// closest hit before `hit.t` (which it lowers), or with `any`, the first one found.
+// Returns whether it found one.
 bool traverse(uint root, vec3 origin, vec3 dir, float tmin, bool any, uint cut_seed, inout Hit hit) {
     if (root == RAY_NONE) {
         return false;
     }
     // A direction component of exactly zero divides to an infinity of the right sign.
     vec3 inv_dir = 1.0 / dir;
-    uint stack[RAY_STACK_SIZE];
-    float stack_t[RAY_STACK_SIZE];
+    uint oct_inv4 = octant_inv4(dir);
+    uvec2 stack[RAY_STACK_SIZE];
     int top = 0;
     bool found = false;
-    uint node = root;
-    BvhNode n = bvh_nodes[node];
-    if (enter_box(n, origin, inv_dir, tmin, hit.t) > hit.t) {
-        return false;
-    }
+    // The root as the only inner child of a group at `root`.
+    uvec2 nodes = uvec2(root, 0x80000000u);
+    uvec2 triangles = uvec2(0u);
     while (true) {
-        uint leaf = floatBitsToUint(n.max_leaf.w);
-        if (leaf != 0u) {
-            uint first = leaf & ((1u << RAY_LEAF_FIRST_BITS) - 1u);
-            uint count = leaf >> RAY_LEAF_FIRST_BITS;
-            for (uint i = first; i < first + count; i++) {
-                float t;
-                vec2 bary;
-                if (intersect_triangle(ray_triangles[i], origin, dir, tmin, hit.t, t, bary) && !cut_out(i, bary, cut_seed)) {
-                    hit.triangle = i;
-                    hit.t = t;
-                    hit.bary = bary;
-                    found = true;
-                    if (any) {
-                        return true;
-                    }
+        while (triangles.y != 0u) {
+            uint k = uint(findMSB(triangles.y));
+            triangles.y &= ~(1u << k);
+            uint i = triangles.x + k;
+            float t;
+            vec2 bary;
+            if (intersect_triangle(ray_triangle(i), origin, dir, tmin, hit.t, t, bary) && !cut_out(i, bary, cut_seed)) {
+                hit.triangle = i;
+                hit.t = t;
+                hit.bary = bary;
+                found = true;
+                if (any) {
+                    return true;
                 }
-            }
-        } else {
-            uint a = node + 1u;
-            BvhNode na = bvh_nodes[a];
-            uint b = floatBitsToUint(na.min_escape.w);
-            BvhNode nb = bvh_nodes[b];
-            float ta = enter_box(na, origin, inv_dir, tmin, hit.t);
-            float tb = enter_box(nb, origin, inv_dir, tmin, hit.t);
-            if (tb < ta) {
-                uint swap_node = a;
-                a = b;
-                b = swap_node;
-                BvhNode swap_box = na;
-                na = nb;
-                nb = swap_box;
-                float swap_t = ta;
-                ta = tb;
-                tb = swap_t;
-            }
-            if (ta <= hit.t) {
-                // The BVHs are shallower than the stack (checked when built).
-                if (tb <= hit.t) {
-                    stack[top] = b;
-                    stack_t[top] = tb;
-                    top++;
-                }
-                node = a;
-                n = na;
-                continue;
             }
         }
-        // The next box on the stack the ray still enters before the closest hit so far.
-        bool next = false;
-        while (top > 0) {
-            top--;
-            if (stack_t[top] <= hit.t) {
-                node = stack[top];
-                n = bvh_nodes[node];
-                next = true;
+        if ((nodes.y & 0xff000000u) != 0u) {
+            uint group = nodes.y;
+            uint bit = uint(findMSB(group));
+            nodes.y &= ~(1u << bit);
+            if ((nodes.y & 0xff000000u) != 0u) {
+                // The BVHs are shallower than the stack (checked when built).
+                stack[top] = nodes;
+                top++;
+            }
+            // The child's slot, and its place among the node's inner children.
+            uint slot = (bit - 24u) ^ (oct_inv4 & 0xffu);
+            uint child = nodes.x + bitCount(group & ~(0xffffffffu << slot));
+            BvhNode n = bvh_node(child);
+            uint hits = intersect_children(n, origin, inv_dir, tmin, hit.t, oct_inv4);
+            nodes = uvec2(n.children.x, (hits & 0xff000000u) | (n.origin_scale.w >> 24u));
+            triangles = uvec2(n.children.y, hits & 0x00ffffffu);
+        } else {
+            nodes = uvec2(0u);
+        }
+        if (triangles.y == 0u && (nodes.y & 0xff000000u) == 0u) {
+            if (top == 0) {
                 break;
             }
-        }
-        if (!next) {
-            break;
+            top--;
+            nodes = stack[top];
         }
     }
     return found;

@@ -1,9 +1,12 @@
-//! The CPU side of ray casting: the scene's triangles in world space, a BVH2 over them
-//! built with obvhs (PLOC, with reinsertion and leaf collapsing: Meister et al. 2018,
-//! 2021), flattened into the GPU's layout with each leaf's triangles contiguous.
+//! The CPU side of ray casting: the scene's triangles in world space, and a compressed
+//! wide BVH over them (CWBVH, Ylitie et al. 2017: eight children a node, their boxes
+//! quantized to bytes in the node's frame), built with obvhs (a PLOC BVH2 with
+//! reinsertion, Meister et al. 2018, 2021, collapsed into the wide one), its triangles
+//! in leaf order.
 
 use glam::{Mat3, Vec3};
 use obvhs::aabb::Aabb;
+use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::BvhBuildParams;
 
 use crate::gpu_layout::{self as layout, BvhNode, RayShading, RayTriangle, RAY_NONE};
@@ -74,15 +77,13 @@ pub struct Bvh {
     pub nodes: Vec<BvhNode>,
     pub triangles: Vec<RayTriangle>,
     pub shading: Vec<RayShading>,
-    /// The longest path from the root to a leaf, in nodes (0 for an empty BVH).
+    /// The longest path from the root to a leaf's node, in nodes (0 for an empty BVH).
     pub depth: u32,
 }
 
 impl Bvh {
     /// The BVH of `triangles`, to sit at node `node_offset` and triangle `triangle_offset`
-    /// of the GPU's buffers (its indices point there), laid out depth first: every inner
-    /// node is followed by its first child, and the second child sits at the first's
-    /// escape index, so a node's children are found from one read.
+    /// of the GPU's buffers (its indices point there), the root first.
     /// `fast`: a quicker build of lower quality, for what is rebuilt every frame.
     pub fn build(
         triangles: &Triangles,
@@ -102,52 +103,37 @@ impl Bvh {
                 Aabb::new(lo.to_array().into(), hi.to_array().into())
             })
             .collect();
-        let params = if fast {
+        let mut params = if fast {
             BvhBuildParams::very_fast_build()
         } else {
             BvhBuildParams::medium_build()
         };
+        // The most a CWBVH leaf holds (its count is unary in three bits).
+        params.max_prims_per_leaf = 3;
         let mut core_time = std::time::Duration::ZERO;
-        let bvh = obvhs::bvh2::builder::build_bvh2(&aabbs, params, &mut core_time);
-        let order: Vec<usize> = bvh.primitive_indices.iter().map(|&i| i as usize).collect();
-        // Depth first, each node followed by its first child's subtree, then its second's;
-        // each node's escape is where traversal goes on when it misses the node's box or
-        // has tested its leaf: the node after its subtree (none after the last).
-        let sizes = subtree_sizes(&bvh.nodes);
-        let mut nodes: Vec<BvhNode> = Vec::with_capacity(bvh.nodes.len());
-        let mut depth = 0;
-        let mut stack = vec![(0usize, 1u32)];
-        while let Some((i, d)) = stack.pop() {
-            depth = depth.max(d);
-            let node = &bvh.nodes[i];
-            let next = nodes.len() + sizes[i];
-            let escape = if next >= bvh.nodes.len() {
-                RAY_NONE
-            } else {
-                next as u32 + node_offset
-            };
-            let leaf = if node.prim_count > 0 {
-                (node.first_index + triangle_offset)
-                    | node.prim_count << layout::RAY_LEAF_FIRST_BITS
-            } else {
-                let first = node.first_index as usize;
-                stack.extend([(first + 1, d + 1), (first, d + 1)]);
-                0
-            };
-            nodes.push(BvhNode {
-                min_escape: Vec3::from(node.aabb.min.to_array())
-                    .extend(f32::from_bits(escape))
-                    .to_array(),
-                max_leaf: Vec3::from(node.aabb.max.to_array())
-                    .extend(f32::from_bits(leaf))
-                    .to_array(),
-            });
-        }
+        let bvh = obvhs::cwbvh::builder::build_cwbvh(&aabbs, params, &mut core_time);
+        let nodes: Vec<BvhNode> = bvh
+            .nodes
+            .iter()
+            .map(|node| {
+                let mut moved = *node;
+                moved.child_base_idx += node_offset;
+                moved.primitive_base_idx += triangle_offset;
+                bytemuck::cast(moved)
+            })
+            .collect();
+        let order = &bvh.primitive_indices;
         Self {
+            depth: depth(&bvh.nodes),
             nodes,
-            triangles: order.iter().map(|&i| triangles.triangles[i]).collect(),
-            shading: order.iter().map(|&i| triangles.shading[i]).collect(),
-            depth,
+            triangles: order
+                .iter()
+                .map(|&i| triangles.triangles[i as usize])
+                .collect(),
+            shading: order
+                .iter()
+                .map(|&i| triangles.shading[i as usize])
+                .collect(),
         }
     }
 
@@ -161,22 +147,18 @@ impl Bvh {
     }
 }
 
-/// The number of nodes in each node's subtree, itself included.
-fn subtree_sizes(nodes: &[obvhs::bvh2::node::Bvh2Node]) -> Vec<usize> {
-    let mut sizes = vec![1; nodes.len()];
-    // Post-order: a node's size once both children's are known.
-    let mut stack = vec![(0usize, false)];
-    while let Some((i, children_done)) = stack.pop() {
+/// The longest path from the root (node 0) to a node, in nodes.
+fn depth(nodes: &[CwBvhNode]) -> u32 {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 1u32)];
+    while let Some((i, d)) = stack.pop() {
+        deepest = deepest.max(d);
         let node = &nodes[i];
-        if node.prim_count > 0 {
-            continue;
-        }
-        let first = node.first_index as usize;
-        if children_done {
-            sizes[i] = 1 + sizes[first] + sizes[first + 1];
-        } else {
-            stack.extend([(i, true), (first, false), (first + 1, false)]);
+        for child in 0..8 {
+            if !node.is_leaf(child) {
+                stack.push((node.child_node_index(child) as usize, d + 1));
+            }
         }
     }
-    sizes
+    deepest
 }

@@ -2,9 +2,9 @@
 //! (`glsl/ray/rays.glsl`): the closest hit (triangle, barycentrics, material, normal) and
 //! any hit (visibility), through the first bindings of its set 3 (`BINDING_RAY_*`).
 //!
-//! Two BVH2s: the static meshes', built once, and the moving meshes', built again every
-//! frame at the frame's time (a rebuild over their triangles alone: they are few; a refit
-//! would keep a tree built for other positions). The nodes and triangles of both sit in
+//! Two compressed eight-wide BVHs (CWBVH): the static meshes', built once, and the moving
+//! meshes', built again every frame at the frame's time (a rebuild over their triangles
+//! alone: they are few; a refit would keep a tree built for other positions). The nodes and triangles of both sit in
 //! the same buffers, the moving meshes' after the static ones', rewritten in the frame's
 //! command buffer from a staging buffer per frame in flight.
 
@@ -22,13 +22,14 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use crate::gpu_layout::{
-    self as layout, BvhNode, RayEmitter, RayShading, RayTriangle, RayUniforms, RAY_NONE,
+    self as layout, BvhNode, GpuMaterial, RayEmitter, RayShading, RayTriangle, RayUniforms,
+    RAY_NONE,
 };
 use crate::scene::Scene;
-use crate::scene_gpu::upload_texture;
+use crate::scene_gpu::{gpu_materials, upload_texture};
 use crate::vk::{
     memory_barrier, sampler_info, upload_buffer, Binding, Buffer, Context, Image, OneShot, Sampler,
-    SetWriter,
+    SetWriter, TexelView,
 };
 pub use bvh::{Bvh, Triangles};
 
@@ -49,10 +50,13 @@ pub struct BuildStats {
 
 /// The scene's triangles on the GPU, ready to cast rays against.
 pub struct SceneRays {
+    /// The buffers below as texel buffers (dropped before them).
+    views: Vec<(u32, TexelView)>,
     uniforms: Buffer,
     nodes: Buffer,
     triangles: Buffer,
     shading: Buffer,
+    materials: Buffer,
     emitters: Buffer,
     textures: Buffer,
     atlas: Image,
@@ -73,8 +77,9 @@ pub struct SceneRays {
 /// The stages that cast rays.
 const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::COMPUTE;
 
-/// The most triangles the BVHs hold (a leaf's first triangle has `RAY_LEAF_FIRST_BITS`).
-const MAX_TRIANGLES: usize = 1 << layout::RAY_LEAF_FIRST_BITS;
+/// The most triangles the BVHs hold: a triangle's shading is texel 4i of its buffer, an
+/// `int` in GLSL.
+const MAX_TRIANGLES: usize = 1 << 29;
 
 /// Refuses a BVH deeper than the traversal stack holds (it pushes a node per level at most).
 fn check_depth(depth: u32, what: &str) -> Result<()> {
@@ -88,12 +93,13 @@ fn check_depth(depth: u32, what: &str) -> Result<()> {
 }
 
 /// Refuses a buffer of `size` bytes beyond `limit`, the most the device binds in one
-/// storage buffer (`maxStorageBufferRange`), naming both.
+/// texel buffer, naming both.
 fn check_buffer_size(name: &str, size: u64, limit: u64) -> Result<()> {
     if size > limit {
         bail!(
             "the scene's {name} need {size} bytes ({:.1} MiB), more than the {limit} bytes \
-             ({:.1} MiB) the device binds in one storage buffer",
+             ({:.1} MiB) the device binds in one texel buffer (maxTexelBufferElements of 16 \
+             bytes)",
             size as f64 / 1048576.0,
             limit as f64 / 1048576.0
         );
@@ -101,27 +107,32 @@ fn check_buffer_size(name: &str, size: u64, limit: u64) -> Result<()> {
     Ok(())
 }
 
+/// The texel format of every buffer rays read: an integer format, whose fetches return
+/// every bit as stored (the indices kept in float lanes are denormals, which a float
+/// format's fetch may flush).
+const TEXEL_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
+
 impl SceneRays {
     /// The set-3 bindings every ray-casting pass starts with.
     pub fn bindings() -> Vec<Binding> {
-        let storage = vk::DescriptorType::STORAGE_BUFFER;
+        let texels = vk::DescriptorType::UNIFORM_TEXEL_BUFFER;
         vec![
             Binding::new(
                 layout::BINDING_RAY_UNIFORMS,
                 vk::DescriptorType::UNIFORM_BUFFER,
                 STAGES,
             ),
-            Binding::new(layout::BINDING_RAY_NODES, storage, STAGES),
-            Binding::new(layout::BINDING_RAY_TRIANGLES, storage, STAGES),
-            Binding::new(layout::BINDING_RAY_SHADING, storage, STAGES),
-            Binding::new(layout::BINDING_RAY_MATERIALS, storage, STAGES),
+            Binding::new(layout::BINDING_RAY_NODES, texels, STAGES),
+            Binding::new(layout::BINDING_RAY_TRIANGLES, texels, STAGES),
+            Binding::new(layout::BINDING_RAY_SHADING, texels, STAGES),
+            Binding::new(layout::BINDING_RAY_MATERIALS, texels, STAGES),
             Binding::new(
                 layout::BINDING_RAY_ATLAS,
                 vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
                 STAGES,
             ),
-            Binding::new(layout::BINDING_RAY_TEXTURES, storage, STAGES),
-            Binding::new(layout::BINDING_RAY_EMITTERS, storage, STAGES),
+            Binding::new(layout::BINDING_RAY_TEXTURES, texels, STAGES),
+            Binding::new(layout::BINDING_RAY_EMITTERS, texels, STAGES),
         ]
     }
 
@@ -158,21 +169,24 @@ impl SceneRays {
         let static_nodes = built.nodes.len() as u32;
         let static_triangles = built.triangles.len() as u32;
         let moving_triangles = moving.len() as u32;
-        // A BVH2 of n leaves has 2n - 1 nodes, and leaves hold a triangle or more.
-        let node_capacity = static_nodes + (2 * moving_triangles).max(1);
+        // Every inner node has two children or more, and every leaf a triangle or more: a
+        // BVH of n triangles has fewer than n nodes (but one, for one triangle).
+        let node_capacity = static_nodes + moving_triangles + 1;
         let triangle_capacity = (static_triangles + moving_triangles).max(1);
         let one_shot = OneShot::new(ctx)?;
-        let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
-        let sized = |name: &str, element: usize, count: u32, data: &[u8]| -> Result<Buffer> {
+        let limit = 16 * u64::from(ctx.properties.limits.max_texel_buffer_elements);
+        let sized = |name: &str, element: usize, count: u32, data: &[u8]| {
             let size = (element as u64 * u64::from(count)).max(16);
-            check_buffer_size(
-                name,
-                size,
-                u64::from(ctx.properties.limits.max_storage_buffer_range),
-            )?;
+            check_buffer_size(name, size, limit)?;
             let mut bytes = data.to_vec();
             bytes.resize(size as usize, 0);
-            upload_buffer(ctx, &one_shot, name, &bytes, usage)
+            upload_buffer(
+                ctx,
+                &one_shot,
+                name,
+                &bytes,
+                vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            )
         };
         let nodes = sized(
             "ray BVH nodes",
@@ -212,17 +226,18 @@ impl SceneRays {
             packed.height,
             &[texels],
         )?;
-        let rects: Vec<[u32; 4]> = if packed.rects.is_empty() {
-            vec![[0; 4]]
-        } else {
-            packed.rects
-        };
-        let textures = upload_buffer(
-            ctx,
-            &one_shot,
+        let textures = sized(
             "ray texture rects",
-            bytemuck::cast_slice(&rects),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
+            std::mem::size_of::<[u32; 4]>(),
+            packed.rects.len() as u32,
+            bytemuck::cast_slice(&packed.rects),
+        )?;
+        let gpu_materials = gpu_materials(scene);
+        let materials = sized(
+            "ray materials",
+            std::mem::size_of::<GpuMaterial>(),
+            gpu_materials.len() as u32,
+            bytemuck::cast_slice(&gpu_materials),
         )?;
         let bounds = scene.swept_bounds();
         let uniforms = RayUniforms {
@@ -259,10 +274,28 @@ impl SceneRays {
             &sampler_info(vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE),
         )?;
         Ok(Self {
+            views: [
+                (layout::BINDING_RAY_NODES, &nodes, "ray BVH nodes"),
+                (layout::BINDING_RAY_TRIANGLES, &triangles, "ray triangles"),
+                (
+                    layout::BINDING_RAY_SHADING,
+                    &shading,
+                    "ray triangle shading",
+                ),
+                (layout::BINDING_RAY_MATERIALS, &materials, "ray materials"),
+                (layout::BINDING_RAY_TEXTURES, &textures, "ray texture rects"),
+                (layout::BINDING_RAY_EMITTERS, &emitters, "ray emitters"),
+            ]
+            .into_iter()
+            .map(|(binding, buffer, name)| {
+                Ok((binding, TexelView::new(ctx, name, buffer, TEXEL_FORMAT)?))
+            })
+            .collect::<Result<_>>()?,
             uniforms,
             nodes,
             triangles,
             shading,
+            materials,
             emitters,
             textures,
             atlas,
@@ -279,33 +312,28 @@ impl SceneRays {
     /// Bytes the moving meshes' part takes in a staging buffer: nodes, triangles, shading.
     fn moving_bytes(moving_triangles: u32) -> usize {
         let n = moving_triangles as usize;
-        2 * n * std::mem::size_of::<BvhNode>()
+        (n + 1) * std::mem::size_of::<BvhNode>()
             + n * (std::mem::size_of::<RayTriangle>() + std::mem::size_of::<RayShading>())
     }
 
-    /// Writes the ray-casting bindings into `set`; `materials` is the scene's material
-    /// buffer.
-    pub fn write_set(&self, set: vk::DescriptorSet, materials: &Buffer) {
-        let storage = vk::DescriptorType::STORAGE_BUFFER;
-        SetWriter::new(&self.ctx, set)
+    /// Writes the ray-casting bindings into `set`.
+    pub fn write_set(&self, set: vk::DescriptorSet) {
+        let mut writer = SetWriter::new(&self.ctx, set)
             .buffer(
                 layout::BINDING_RAY_UNIFORMS,
                 vk::DescriptorType::UNIFORM_BUFFER,
                 self.uniforms.raw,
             )
-            .buffer(layout::BINDING_RAY_NODES, storage, self.nodes.raw)
-            .buffer(layout::BINDING_RAY_TRIANGLES, storage, self.triangles.raw)
-            .buffer(layout::BINDING_RAY_SHADING, storage, self.shading.raw)
-            .buffer(layout::BINDING_RAY_MATERIALS, storage, materials.raw)
             .sampled_image(
                 layout::BINDING_RAY_ATLAS,
                 self.atlas.view,
                 self.atlas_sampler.raw,
                 vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            )
-            .buffer(layout::BINDING_RAY_TEXTURES, storage, self.textures.raw)
-            .buffer(layout::BINDING_RAY_EMITTERS, storage, self.emitters.raw)
-            .apply();
+            );
+        for (binding, view) in &self.views {
+            writer = writer.texel_buffer(*binding, view.raw);
+        }
+        writer.apply();
     }
 
     /// Whether the scene has moving meshes, whose BVH [`Self::record_moving`] rebuilds.
@@ -366,7 +394,7 @@ impl SceneRays {
             cmd,
             (
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ,
+                vk::AccessFlags2::SHADER_SAMPLED_READ,
             ),
             (
                 vk::PipelineStageFlags2::ALL_TRANSFER,
@@ -401,7 +429,7 @@ impl SceneRays {
             ),
             (
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::UNIFORM_READ,
+                vk::AccessFlags2::SHADER_SAMPLED_READ | vk::AccessFlags2::UNIFORM_READ,
             ),
         );
         Ok(())
@@ -414,6 +442,7 @@ impl SceneRays {
             ("ray_triangles", self.triangles.size + self.shading.size),
             ("ray_texture_atlas", self.atlas.memory_bytes()),
             ("ray_emitters", self.emitters.size),
+            ("ray_materials", self.materials.size + self.textures.size),
         ]
     }
 }

@@ -27,13 +27,8 @@ pub struct RayQueries {
 }
 
 impl RayQueries {
-    /// Queries against `rays`, whose materials are `materials`.
-    pub fn new(
-        ctx: &Arc<Context>,
-        rays: &SceneRays,
-        materials: &Buffer,
-        capacity: usize,
-    ) -> Result<Self> {
+    /// Queries against `rays`.
+    pub fn new(ctx: &Arc<Context>, rays: &SceneRays, capacity: usize) -> Result<Self> {
         ensure!(capacity > 0, "a ray query batch needs room for a ray");
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         let compute = vk::ShaderStageFlags::COMPUTE;
@@ -65,7 +60,7 @@ impl RayQueries {
             vk::BufferUsageFlags::STORAGE_BUFFER,
             MemoryLocation::GpuToCpu,
         )?;
-        rays.write_set(set, materials);
+        rays.write_set(set);
         SetWriter::new(ctx, set)
             .buffer(layout::BINDING_QUERY_RAYS, storage, queries.raw)
             .buffer(layout::BINDING_QUERY_HITS, storage, hits.raw)

@@ -105,6 +105,7 @@ pub struct SetWriter<'a> {
     set: vk::DescriptorSet,
     buffers: Vec<(u32, vk::DescriptorType, vk::DescriptorBufferInfo)>,
     images: Vec<(u32, vk::DescriptorType, Vec<vk::DescriptorImageInfo>)>,
+    texel_views: Vec<(u32, vk::BufferView)>,
     ctx: &'a Context,
 }
 
@@ -114,6 +115,7 @@ impl<'a> SetWriter<'a> {
             set,
             buffers: Vec::new(),
             images: Vec::new(),
+            texel_views: Vec::new(),
             ctx,
         }
     }
@@ -125,6 +127,12 @@ impl<'a> SetWriter<'a> {
             range: vk::WHOLE_SIZE,
         };
         self.buffers.push((binding, kind, info));
+        self
+    }
+
+    /// A uniform texel buffer (`samplerBuffer`).
+    pub fn texel_buffer(mut self, binding: u32, view: vk::BufferView) -> Self {
+        self.texel_views.push((binding, view));
         self
     }
 
@@ -198,6 +206,15 @@ impl<'a> SetWriter<'a> {
                     .dst_binding(*binding)
                     .descriptor_type(*kind)
                     .image_info(infos),
+            );
+        }
+        for (binding, view) in &self.texel_views {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(self.set)
+                    .dst_binding(*binding)
+                    .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
+                    .texel_buffer_view(std::slice::from_ref(view)),
             );
         }
         unsafe { self.ctx.device.update_descriptor_sets(&writes, &[]) };

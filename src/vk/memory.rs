@@ -92,6 +92,43 @@ impl Buffer {
     }
 }
 
+/// A typed view of a buffer for `samplerBuffer` reads (a uniform texel buffer),
+/// destroyed when dropped (drop it before its buffer).
+pub struct TexelView {
+    pub raw: vk::BufferView,
+    ctx: Arc<Context>,
+}
+
+impl TexelView {
+    /// The whole of `buffer` as texels of `format`; the buffer needs the
+    /// `UNIFORM_TEXEL_BUFFER` usage.
+    pub fn new(
+        ctx: &Arc<Context>,
+        name: &str,
+        buffer: &Buffer,
+        format: vk::Format,
+    ) -> Result<Self> {
+        let info = vk::BufferViewCreateInfo::default()
+            .buffer(buffer.raw)
+            .format(format)
+            .offset(0)
+            .range(vk::WHOLE_SIZE);
+        let raw = unsafe { ctx.device.create_buffer_view(&info, None) }
+            .with_context(|| format!("creating the texel view of buffer {name}"))?;
+        ctx.set_name(raw, name);
+        Ok(Self {
+            raw,
+            ctx: ctx.clone(),
+        })
+    }
+}
+
+impl Drop for TexelView {
+    fn drop(&mut self) {
+        unsafe { self.ctx.device.destroy_buffer_view(self.raw, None) };
+    }
+}
+
 impl Drop for Buffer {
     fn drop(&mut self) {
         unsafe { self.ctx.device.destroy_buffer(self.raw, None) };

@@ -125,6 +125,10 @@ impl Swapchain {
             .old_swapchain(old);
         let raw = unsafe { self.loader.create_swapchain(&info, None) }
             .context("creating the swapchain")?;
+        // The frames are done, but a present may still wait on an image's `rendered`
+        // semaphore: no fence or timeline value covers a present's waits, only an idle
+        // device does (without VK_EXT_swapchain_maintenance1's present fences).
+        unsafe { ctx.device.device_wait_idle() }.context("waiting for the last present")?;
         self.destroy_images();
         if old != vk::SwapchainKHR::null() {
             unsafe { self.loader.destroy_swapchain(old, None) };

@@ -57,8 +57,8 @@ struct Surface {
 // screen-space derivatives: both give the same frame, the edges exactly. The sign of
 // n . (e1 x e2) keeps the frame the gradients of u and v from the back side too.
 vec3 apply_normal_map(uint i, vec3 n, uint map, vec2 uv) {
-    RayTriangle tri = ray_triangles[i];
-    RayShading sh = ray_shading[i];
+    RayTriangle tri = ray_triangle(i);
+    RayShading sh = ray_shading(i);
     vec2 uv0 = vec2(sh.n0.w, sh.n1.w);
     vec2 duv1 = vec2(sh.n2.w, sh.uv.x) - uv0;
     vec2 duv2 = sh.uv.yz - uv0;
@@ -79,9 +79,9 @@ vec3 apply_normal_map(uint i, vec3 n, uint map, vec2 uv) {
 }
 
 Surface surface_at(Hit hit, vec3 dir) {
-    RayTriangle tri = ray_triangles[hit.triangle];
-    RayShading sh = ray_shading[hit.triangle];
-    GpuMaterial m = ray_materials[floatBitsToUint(tri.v0.w)];
+    RayTriangle tri = ray_triangle(hit.triangle);
+    RayShading sh = ray_shading(hit.triangle);
+    GpuMaterial m = ray_material(floatBitsToUint(tri.v0.w));
     float w = 1.0 - hit.bary.x - hit.bary.y;
     Surface s;
     s.p = tri.v0.xyz + tri.e1.xyz * hit.bary.x + tri.e2.xyz * hit.bary.y;
@@ -231,13 +231,13 @@ vec3 emitter_light(Surface s, vec3 origin, inout uint rng) {
     uint hi = rays.emitter_count - 1u;
     while (lo < hi) {
         uint mid = (lo + hi) / 2u;
-        if (emitters[mid].cdf < pick) {
+        if (ray_emitter(mid).cdf < pick) {
             lo = mid + 1u;
         } else {
             hi = mid;
         }
     }
-    RayTriangle tri = ray_triangles[emitters[lo].triangle];
+    RayTriangle tri = ray_triangle(ray_emitter(lo).triangle);
     float su = sqrt(random_next(rng));
     float r = random_next(rng);
     vec3 q = tri.v0.xyz + su * (1.0 - r) * tri.e1.xyz + su * r * tri.e2.xyz;
@@ -250,7 +250,7 @@ vec3 emitter_light(Surface s, vec3 origin, inout uint rng) {
     if (cos_light <= 0.0 || cos_s <= 0.0 || dot(s.ng, l) <= 0.0 || !visible(origin, l, dist * (1.0 - 1e-4), rng)) {
         return vec3(0.0);
     }
-    vec3 radiance = ray_materials[floatBitsToUint(tri.v0.w)].emission.rgb;
+    vec3 radiance = ray_material(floatBitsToUint(tri.v0.w)).emission.rgb;
     float light_pdf = emitter_pdf(max(radiance.r, max(radiance.g, radiance.b)), dist, cos_light);
     float weight = mis_weight(light_pdf, bsdf_pdf(s, l));
     return brdf(s, l) * radiance * cos_s * weight / light_pdf;
@@ -315,7 +315,7 @@ bool extend(inout Path p) {
     Surface s = surface_at(hit, p.dir);
     if (any(greaterThan(s.emitted, vec3(0.0)))) {
         float weight = 1.0;
-        RayTriangle tri = ray_triangles[hit.triangle];
+        RayTriangle tri = ray_triangle(hit.triangle);
         bool sampled = (floatBitsToUint(tri.e2.w) & RAY_MOVING) == 0u && rays.emitter_count > 0u;
         if (p.bsdf_pdf > 0.0 && sampled) {
             float largest = max(s.emitted.r, max(s.emitted.g, s.emitted.b));

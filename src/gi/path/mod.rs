@@ -168,7 +168,7 @@ impl PathTracer {
             MemoryLocation::GpuToCpu,
         )?;
         rays_cast.write(0, &[0; 4]);
-        rays.write_set(set, &inputs.gpu.materials);
+        rays.write_set(set);
         SetWriter::new(ctx, set)
             .buffer(
                 layout::BINDING_PATH_UNIFORMS,
