@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Result};
+use anyhow::{anyhow, bail, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::gi::path::cli::PathArgs;
@@ -78,7 +78,7 @@ pub struct CommonArgs {
     #[arg(long)]
     pub no_refraction: bool,
     /// Exposure in stops before the tonemap (PNG and window only; EXR stays raw radiance).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_finite)]
     pub exposure: f32,
     /// Tonemap for PNG and window output.
     #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
@@ -122,7 +122,7 @@ pub struct CommonArgs {
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=10))]
     pub debug_level: u32,
     /// Scene time in seconds (animation).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_finite)]
     pub time: f32,
 }
 
@@ -197,7 +197,7 @@ pub struct CompareArgs {
     /// Test image (.exr linear or .png sRGB).
     pub test: PathBuf,
     /// Exposure in stops applied to EXR inputs before the LDR metrics.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_finite)]
     pub exposure: f32,
     /// Write the metrics as JSON here.
     #[arg(long)]
@@ -216,6 +216,18 @@ pub struct CompareArgs {
 pub const MAX_IMAGE_SIDE: u32 = 16384;
 
 /// Parses `WIDTHxHEIGHT`.
+/// A number option: finite (NaN and infinities would pass every range check after it).
+pub fn parse_finite(text: &str) -> Result<f32> {
+    let value: f32 = text
+        .trim()
+        .parse()
+        .map_err(|_| anyhow!("expected a number, got {text:?}"))?;
+    if !value.is_finite() {
+        bail!("expected a finite number, got {text:?}");
+    }
+    Ok(value)
+}
+
 pub fn parse_size(text: &str) -> Result<(u32, u32)> {
     let Some((w, h)) = text.split_once(['x', 'X']) else {
         bail!("expected WIDTHxHEIGHT, e.g. 1280x720, got {text:?}");
@@ -369,6 +381,20 @@ mod tests {
             GiSettings::ConeTracing(vct) => vct,
             _ => panic!("no cone tracing"),
         }
+    }
+
+    /// NaN and infinities are refused by every number option (they pass range checks).
+    #[test]
+    fn number_options_must_be_finite() {
+        assert_eq!(parse_finite(" -2.5").unwrap(), -2.5);
+        for text in ["nan", "NaN", "inf", "-inf", "infinity", "1e39"] {
+            let error = parse_finite(text).unwrap_err().to_string();
+            assert!(error.contains("finite") && error.contains(text), "{error}");
+        }
+        assert!(parse_finite("two")
+            .unwrap_err()
+            .to_string()
+            .contains("a number"));
     }
 
     /// A binary away from its checkout loads the copy of the built-in scene it carries.

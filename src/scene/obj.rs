@@ -113,14 +113,21 @@ fn parse(path: &Path) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>, Vec<Path
     let dir = path.parent().unwrap_or(Path::new(""));
     // tobj keeps going after a failed mtllib and only reports an error when no MTL loaded at
     // all, so every failure is recorded here to name the file.
-    let failures = RefCell::new(Vec::new());
+    let failures: RefCell<Vec<(PathBuf, String)>> = RefCell::new(Vec::new());
     let material_dirs = RefCell::new(Vec::new());
     // GPU_LOAD_OPTIONS: triangulated, one index for position, normal and uv, and points and
     // lines dropped (they are not surfaces).
     let (models, materials) =
         tobj::load_obj_buf(&mut BufReader::new(file), &tobj::GPU_LOAD_OPTIONS, |mtl| {
             let mtl_path = dir.join(mtl);
-            let result = tobj::load_mtl(&mtl_path);
+            let text = match read_mtl(&mtl_path) {
+                Ok(text) => text,
+                Err(e) => {
+                    failures.borrow_mut().push((mtl_path, format!("{e:#}")));
+                    return Err(tobj::LoadError::MaterialParseError);
+                }
+            };
+            let result = tobj::load_mtl_buf(&mut text.as_bytes());
             match &result {
                 Ok((materials, _)) => {
                     let mtl_dir = mtl_path.parent().unwrap_or(Path::new("")).to_path_buf();
@@ -128,28 +135,72 @@ fn parse(path: &Path) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>, Vec<Path
                         .borrow_mut()
                         .extend(std::iter::repeat_n(mtl_dir, materials.len()));
                 }
-                Err(e) => failures.borrow_mut().push((mtl_path, *e)),
+                Err(e) => failures
+                    .borrow_mut()
+                    .push((mtl_path, format!("cannot parse: {e}"))),
             }
             result
         })
         .map_err(|e| anyhow!("cannot parse OBJ {}: {e}", path.display()))?;
     if let Some((mtl, e)) = failures.into_inner().first() {
-        if !mtl.is_file() {
-            bail!(
-                "MTL file {} (mtllib of {}) not found",
-                mtl.display(),
-                path.display()
-            );
-        }
-        bail!(
-            "cannot parse MTL {} (mtllib of {}): {e}",
-            mtl.display(),
-            path.display()
-        );
+        bail!("MTL {} (mtllib of {}): {e}", mtl.display(), path.display());
     }
     let materials =
         materials.map_err(|e| anyhow!("cannot load the MTLs of {}: {e}", path.display()))?;
     Ok((models, materials, material_dirs.into_inner()))
+}
+
+/// The colours an MTL gives as `r [g b]`, which tobj reads as three numbers.
+const MTL_COLOURS: [&str; 4] = ["Ka", "Kd", "Ks", "Ke"];
+
+/// The scalars an MTL gives that must be finite and not negative.
+const MTL_SCALARS: [&str; 4] = ["Ns", "Ni", "d", "Tr"];
+
+/// The text of MTL `path`, checked and made readable by tobj: a colour given by one value
+/// (the format's `Kd r`, g and b equal to r) repeated three times, which tobj would
+/// panic on; a colour of two values, or a colour or scalar not finite or negative, refused
+/// with its line.
+fn read_mtl(path: &Path) -> Result<String> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        if path.is_file() {
+            anyhow!("cannot read it: {e}")
+        } else {
+            anyhow!("not found")
+        }
+    })?;
+    let mut out = String::with_capacity(text.len());
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let key = words.next().unwrap_or("");
+        let values: Vec<&str> = words.collect();
+        let colour = MTL_COLOURS.contains(&key);
+        if colour || MTL_SCALARS.contains(&key) {
+            // `Kd spectral file.rfl` and `Kd xyz x y z` are left to tobj, which refuses them.
+            let numbers: Option<Vec<f32>> = values.iter().map(|v| v.parse().ok()).collect();
+            if let Some(numbers) = numbers {
+                if let Some(bad) = numbers.iter().find(|v| !v.is_finite() || **v < 0.0) {
+                    bail!(
+                        "line {}: {key} {bad} is not a finite number of at least 0",
+                        n + 1
+                    );
+                }
+                if colour && numbers.len() == 2 {
+                    bail!(
+                        "line {}: {key} takes one value (grey) or three (r g b), not two",
+                        n + 1
+                    );
+                }
+                if colour && numbers.len() == 1 {
+                    let v = values[0];
+                    out.push_str(&format!("{key} {v} {v} {v}\n"));
+                    continue;
+                }
+            }
+        }
+        out.push_str(line);
+        out.push('\n');
+    }
+    Ok(out)
 }
 
 fn convert_material(

@@ -19,19 +19,19 @@ pub struct VctArgs {
     #[arg(long)]
     pub octree_depth: Option<u32>,
     /// Full aperture of each diffuse cone, degrees, 1 to 179 [default: 60].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::parse_finite)]
     pub diffuse_aperture: Option<f32>,
     /// Step of the cones gathering light for the pixels (diffuse, specular, refraction)
     /// as a fraction of the cone's diameter (beta), 0.05 to 2 [default: 0.25].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::parse_finite)]
     pub step_factor: Option<f32>,
     /// Step of the voxel bounce's diffuse cones as a fraction of the cone's diameter,
     /// 0.05 to 2 [default: 0.5].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::parse_finite)]
     pub bounce_step_factor: Option<f32>,
     /// Step of the soft-shadow cones as a fraction of the cone's diameter, 0.05 to 2
     /// [default: 0.5].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::parse_finite)]
     pub shadow_step_factor: Option<f32>,
     /// Step the diffuse cones level by level, each sample twice as far and wide as the
     /// last (Dřínovský's sampling of wide cones), instead of by the step factor.
@@ -60,11 +60,11 @@ pub struct VctArgs {
     pub shadow_cones: bool,
     /// Full aperture of the soft-shadow cones, degrees, 0.1 to 90: the apparent size of
     /// the lights [default: 4].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::parse_finite)]
     pub shadow_aperture: Option<f32>,
     /// Ambient occlusion: occluders this many voxels away occlude half as much, 0.1 to
     /// 1024 [default: 4].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cli::parse_finite)]
     pub ao_distance: Option<f32>,
     /// Re-voxelize and re-shade the static geometry every frame too (for benchmarks);
     /// by default static geometry is voxelized once and only moving meshes every frame.

@@ -15,6 +15,20 @@ fn load(path: &Path, options: &LoadOptions) -> Result<(Vec<Mesh>, Vec<Material>,
     geometry.finish()
 }
 
+/// The MTL format's one-value colours (`Kd r`: g and b equal r), on which tobj panics.
+#[test]
+fn one_value_colours_are_grey() {
+    let dir = TempDir::new("grey");
+    dir.write("g.mtl", "newmtl grey\nKd 0.25\nKa 1\nKs 0.5\nKe 2\n");
+    let obj = dir.write(
+        "g.obj",
+        "mtllib g.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl grey\nf 1 2 3\n",
+    );
+    let (_, materials, _) = load(&obj, &LoadOptions::default()).unwrap();
+    assert_eq!(materials[0].albedo, Vec3::splat(0.25));
+    assert_eq!(materials[0].emission, Vec3::splat(2.0));
+}
+
 #[test]
 fn quad_materials_uvs_and_flat_normals() {
     let dir = TempDir::new("quad");
@@ -156,6 +170,25 @@ fn errors_name_the_file() {
         message.contains("broken.mtl") && message.contains("parse"),
         "{message}"
     );
+
+    for (line, expected) in [
+        ("Kd 0.5 0.5", "not two"),
+        ("Kd nan", "Kd NaN is not a finite number"),
+        ("Kd inf 0 0", "Kd inf is not a finite number"),
+        ("Ke -10", "Ke -10 is not a finite number"),
+        ("Ns -1", "Ns -1 is not a finite number"),
+    ] {
+        dir.write("bad.mtl", &format!("newmtl x\n{line}\n"));
+        let bad = dir.write(
+            "bad.obj",
+            "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        );
+        let message = error_text(load(&bad, &LoadOptions::default()));
+        assert!(
+            message.contains("bad.mtl") && message.contains("line 2") && message.contains(expected),
+            "{line}: {message}"
+        );
+    }
 
     dir.write("t.mtl", "newmtl brick\nmap_Kd gone.png\n");
     let texture = dir.write(
