@@ -155,8 +155,8 @@ pub struct ViewArgs {
     /// Initial window size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
-    /// Save a PNG screenshot of the last frame here on exit.
-    #[arg(long)]
+    /// Save a PNG screenshot of the last frame here on exit (a `.png` path).
+    #[arg(long, value_parser = parse_png_path)]
     pub screenshot: Option<PathBuf>,
     /// Ask the window system to resize the window to WIDTHxHEIGHT halfway through
     /// `--frames` (smoke tests of swapchain recreation).
@@ -164,15 +164,18 @@ pub struct ViewArgs {
     pub resize_to: Option<(u32, u32)>,
 }
 
+/// The most frames `bench` times or warms up with: together they count in a u32.
+pub const MAX_BENCH_FRAMES: u32 = 1_000_000;
+
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     #[command(flatten)]
     pub common: CommonArgs,
     /// Frames to time (after warm-up frames).
-    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=MAX_BENCH_FRAMES as i64))]
     pub frames: u32,
     /// Frames rendered before timing (first-use shader compiles).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=MAX_BENCH_FRAMES as i64))]
     pub warmup: u32,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
@@ -216,6 +219,20 @@ pub struct CompareArgs {
 pub const MAX_IMAGE_SIDE: u32 = 16384;
 
 /// Parses `WIDTHxHEIGHT`.
+/// A path the viewer writes a PNG to: its extension must say so (a `.jpg` would hold PNG
+/// bytes).
+pub fn parse_png_path(text: &str) -> Result<PathBuf> {
+    let path = PathBuf::from(text);
+    let png = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !png {
+        bail!("screenshots are PNG: the path must end in .png, got {text:?}");
+    }
+    Ok(path)
+}
+
 /// A number option: finite (NaN and infinities would pass every range check after it).
 pub fn parse_finite(text: &str) -> Result<f32> {
     let value: f32 = text

@@ -63,9 +63,7 @@ pub fn write_exr(path: &Path, width: u32, height: u32, rgba_linear: &[f32]) -> R
     let rgb = rgb_of(path, width, height, rgba_linear, 4)?;
     let image = image::Rgb32FImage::from_raw(width, height, rgb)
         .with_context(|| format!("{}: image size does not match its data", path.display()))?;
-    image
-        .save_with_format(path, image::ImageFormat::OpenExr)
-        .with_context(|| format!("writing {}", path.display()))
+    write_encoded(path, image, image::ImageFormat::OpenExr)
 }
 
 /// Writes already tonemapped sRGB RGBA bytes as an RGB PNG; alpha is dropped.
@@ -78,9 +76,23 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba8_srgb: &[u8]) -> Res
 pub(crate) fn write_png_rgb(path: &Path, width: u32, height: u32, rgb8: Vec<u8>) -> Result<()> {
     let image = image::RgbImage::from_raw(width, height, rgb8)
         .with_context(|| format!("{}: image size does not match its data", path.display()))?;
+    write_encoded(path, image, image::ImageFormat::Png)
+}
+
+/// Encodes `image` in memory, then writes the file in one call whose error is seen: the
+/// image crate's `save` writes through a buffer whose last write (a small PNG's only one)
+/// happens when it is dropped, an error there lost (a full disk went unreported).
+fn write_encoded(
+    path: &Path,
+    image: impl Into<image::DynamicImage>,
+    format: image::ImageFormat,
+) -> Result<()> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
     image
-        .save_with_format(path, image::ImageFormat::Png)
-        .with_context(|| format!("writing {}", path.display()))
+        .into()
+        .write_to(&mut bytes, format)
+        .with_context(|| format!("encoding {}", path.display()))?;
+    std::fs::write(path, bytes.into_inner()).with_context(|| format!("writing {}", path.display()))
 }
 
 /// Loads an image as RGB floats. `.exr` gives linear radiance (first three channels) and
@@ -216,6 +228,18 @@ mod tests {
 
     fn temp_path(name: &str) -> std::path::PathBuf {
         std::env::temp_dir().join(format!("voxcone-imageio-{}-{name}", std::process::id()))
+    }
+
+    /// A full disk is reported for a small PNG too, whose one write the image crate's
+    /// buffered `save` made only when dropped, its error lost (Linux's /dev/full).
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_full_disk_is_reported() {
+        let full = Path::new("/dev/full");
+        let error = write_png(full, 2, 2, &[128; 16]).unwrap_err();
+        assert!(format!("{error:#}").contains("/dev/full"), "{error:#}");
+        let error = write_exr(full, 2, 2, &[0.5; 16]).unwrap_err();
+        assert!(format!("{error:#}").contains("/dev/full"), "{error:#}");
     }
 
     #[test]

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{bail, Result};
 use ash::vk;
 
 use super::{check_validation, create_context, load_scene, Offscreen};
@@ -143,8 +143,7 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
             let data = box_downsample_srgb8(offscreen.readback.mapped(), width, height, samples);
             crate::imageio::write_png(&args.output, out_width, out_height, &data)
         }
-    }
-    .with_context(|| format!("writing {}", args.output.display()))?;
+    }?;
     check_validation(&ctx)?;
     Ok(args.output.clone())
 }
