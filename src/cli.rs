@@ -414,6 +414,23 @@ mod tests {
             .contains("a number"));
     }
 
+    #[test]
+    fn screenshots_are_png_paths() {
+        assert!(parse_png_path("shot.PNG").is_ok());
+        for text in ["shot.jpg", "shot", "shot.exr"] {
+            let error = parse_png_path(text).unwrap_err().to_string();
+            assert!(error.contains(".png") && error.contains(text), "{error}");
+        }
+    }
+
+    #[test]
+    fn bench_frame_counts_are_bounded() {
+        for option in ["--warmup", "--frames"] {
+            let err = Cli::try_parse_from(["voxcone", "bench", option, "4294967295"]).unwrap_err();
+            assert!(err.to_string().contains("1000000"), "{err}");
+        }
+    }
+
     /// A binary away from its checkout loads the copy of the built-in scene it carries.
     #[test]
     fn builtin_scene_loads_from_the_copy_the_binary_carries() {
