@@ -9,7 +9,7 @@ use crate::gi::path::cli::PathArgs;
 use crate::gi::vct::cli::VctArgs;
 use crate::gi::{DebugView, GiSettings};
 use crate::passes::shadow::ShadowResolution;
-use crate::scene::{GiOverrides, LoadOptions};
+use crate::scene::{GiOverrides, LoadOptions, Scene};
 use crate::settings::{RenderSettings, Terms, Tonemap};
 
 #[derive(Parser, Debug)]
@@ -133,9 +133,9 @@ pub struct RenderArgs {
     /// Output image: .png (tonemapped sRGB) or .exr (linear radiance).
     #[arg(short, long, default_value = "voxcone.png")]
     pub output: PathBuf,
-    /// Image size WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
-    pub size: (u32, u32),
+    /// Image size WIDTHxHEIGHT [default: a reference scene's resolution, else 1280x720].
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
     /// Anti-aliasing: render the frame N times wider and taller and make each pixel the
     /// mean of its NxN samples (a box filter over the pixel, as the path-traced
     /// references use), in linear light; 1 to 4, 1 for one sample per pixel. The indirect
@@ -177,9 +177,9 @@ pub struct BenchArgs {
     /// Frames rendered before timing (first-use shader compiles).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=MAX_BENCH_FRAMES as i64))]
     pub warmup: u32,
-    /// Image size WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
-    pub size: (u32, u32),
+    /// Image size WIDTHxHEIGHT [default: a reference scene's resolution, else 1280x720].
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
     /// Also write the results as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -217,6 +217,12 @@ pub struct CompareArgs {
 
 /// The largest image side, in pixels, of any frame rendered.
 pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// The size of an image of `scene`: `--size`, else what the scene file asks for, else
+/// 1280x720.
+pub fn image_size(option: Option<(u32, u32)>, scene: &Scene) -> (u32, u32) {
+    option.or(scene.image_size).unwrap_or((1280, 720))
+}
 
 /// Parses `WIDTHxHEIGHT`.
 /// A path the viewer writes a PNG to: its extension must say so (a `.jpg` would hold PNG

@@ -68,10 +68,8 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
         bail!("--move-light: the scene has no light to move");
     }
     let triangles = scene.triangle_count;
-    let extent = vk::Extent2D {
-        width: args.size.0,
-        height: args.size.1,
-    };
+    let (width, height) = crate::cli::image_size(args.size, &scene);
+    let extent = vk::Extent2D { width, height };
     let offscreen = Offscreen::new(&ctx, extent)?;
     let mut settings = args.common.render_settings(&scene.gi)?;
     // Every pass runs every frame, so that the table shows what each one costs.

@@ -48,13 +48,14 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
     } else {
         args.supersample
     };
-    let (width, height) = (args.size.0 * samples, args.size.1 * samples);
+    let size = crate::cli::image_size(args.size, &scene);
+    let (width, height) = (size.0 * samples, size.1 * samples);
     if width.max(height) > MAX_IMAGE_SIDE {
         bail!(
-            "--size {}x{} with --supersample {samples} renders {width}x{height}, over {MAX_IMAGE_SIDE} \
+            "size {}x{} with --supersample {samples} renders {width}x{height}, over {MAX_IMAGE_SIDE} \
              pixels per side: lower one of them",
-            args.size.0,
-            args.size.1
+            size.0,
+            size.1
         );
     }
     let ctx = create_context(&args.common, Vec::new())?;
@@ -118,8 +119,8 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
     bar.finish();
     log::info!(
         "rendered {}x{} ({}) in {:.1} ms (last frame's GPU: {})",
-        args.size.0,
-        args.size.1,
+        size.0,
+        size.1,
         match renderer.gi().and_then(|t| t.progress()) {
             Some(p) => format!("{} samples per pixel", p.done),
             None => format!("{samples}x{samples} samples per pixel"),
@@ -132,7 +133,7 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let (out_width, out_height) = args.size;
+    let (out_width, out_height) = size;
     match format {
         Format::Exr => {
             let data: &[f32] = bytemuck::cast_slice(radiance.mapped());

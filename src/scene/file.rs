@@ -384,6 +384,7 @@ pub(super) fn load_geometry(
         source: source.to_path_buf(),
         triangle_count,
         gi: GiOverrides::default(),
+        image_size: None,
     })
 }
 

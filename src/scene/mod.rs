@@ -219,6 +219,9 @@ pub struct Scene {
     pub triangle_count: usize,
     /// GI settings from the scene file.
     pub gi: GiOverrides,
+    /// The image size the scene file asks for (a reference's `resolution`): `render`'s and
+    /// `bench`'s size without `--size`.
+    pub image_size: Option<(u32, u32)>,
 }
 
 impl Scene {

@@ -5,7 +5,8 @@
 //! intensity_W_sr}`, `lights.directional[].{direction_of_travel, irradiance_W_m2}`,
 //! `lights.env_radiance` (null or RGB), `lights.mtl_emission` (false sets the emission scale
 //! to 0), `lights.emission_scale` and `flags.max_depth` (the path tracer's longest path:
-//! -1 for no limit). Other keys are ignored.
+//! -1 for no limit) and `resolution` (`render`'s and `bench`'s default size). Other keys
+//! are ignored.
 
 use std::path::{Path, PathBuf};
 
@@ -25,6 +26,8 @@ struct ReferenceScene {
     lights: ReferenceLights,
     #[serde(default)]
     flags: ReferenceFlags,
+    /// The reference image's `[width, height]`.
+    resolution: Option<[i64; 2]>,
 }
 
 /// How the reference was integrated: the longest path (-1: no limit, 2: direct light).
@@ -141,7 +144,20 @@ fn scene_from_reference(
         Some(depth @ 1..=1024) => Some(depth as u32),
         Some(other) => bail!("flags.max_depth must be -1 (no limit) or 1 to 1024, got {other}"),
     };
+    let image_size = match spec.resolution {
+        None => None,
+        Some([w, h]) => {
+            let side = 1..=i64::from(crate::cli::MAX_IMAGE_SIDE);
+            ensure!(
+                side.contains(&w) && side.contains(&h),
+                "resolution must be [width, height] of 1 to {} pixels each, got [{w}, {h}]",
+                crate::cli::MAX_IMAGE_SIDE
+            );
+            Some((w as u32, h as u32))
+        }
+    };
     let mut scene = load_geometry(&[entry], options, source)?;
+    scene.image_size = image_size;
     scene.camera = camera;
     scene.lights = lights;
     scene.sky = sky;
@@ -171,6 +187,11 @@ mod tests {
         assert_eq!(scene.sky, Vec3::new(0.1, 0.2, 0.3));
         assert_eq!(scene.gi.max_depth, None, "no flags: no limit");
         assert_eq!(
+            scene.image_size,
+            Some((4, 4)),
+            "resolution: the default size"
+        );
+        assert_eq!(
             scene.lights[0].kind,
             LightKind::Directional {
                 direction: Vec3::NEG_Y
@@ -185,6 +206,24 @@ mod tests {
             &LoadOptions::default(),
         ));
         assert!(message.contains("flags.max_depth must be -1"), "{message}");
+
+        for (resolution, expected) in [
+            ("[0, 0]", "got [0, 0]"),
+            ("[-5, 10]", "got [-5, 10]"),
+            ("[20000, 10]", "got [20000, 10]"),
+            ("\"256x256\"", "invalid type"),
+        ] {
+            let bad = json.replace("[4, 4]", resolution);
+            std::fs::write(dir.0.join("ref/bad.scene.json"), bad).unwrap();
+            let message = error_text(Scene::load(
+                &dir.0.join("ref/bad.scene.json"),
+                &LoadOptions::default(),
+            ));
+            assert!(
+                message.contains("bad.scene.json") && message.contains(expected),
+                "{resolution}: {message}"
+            );
+        }
 
         let broken = dir.write("broken.scene.json", "{\"obj\": 3}");
         let message = error_text(Scene::load(&broken, &LoadOptions::default()));
