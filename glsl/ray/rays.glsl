@@ -117,12 +117,11 @@ bool material_refracts(GpuMaterial m) {
     return m.albedo.a < 1.0 && m.emission.a > 1.0;
 }
 
-// Whether triangle `i`, hit at `bary`, lets the ray through: a cut-out material with its
+// Whether triangle `i` (`tri`), hit at `bary`, lets the ray through: a cut-out material with its
 // coverage (d x map_d, map_d alone where it refracts) below one half there (`cut_seed`
 // 0), below a number drawn for this ray and triangle (another seed), or never
 // (`RAY_OPAQUE`).
-bool cut_out(uint i, vec2 bary, uint cut_seed) {
-    RayTriangle tri = ray_triangle(i);
+bool cut_out(uint i, RayTriangle tri, vec2 bary, uint cut_seed) {
     if ((floatBitsToUint(tri.e2.w) & RAY_CUT_OUT) == 0u || cut_seed == RAY_OPAQUE) {
         return false;
     }
@@ -238,7 +237,8 @@ bool traverse(uint root, vec3 origin, vec3 dir, float tmin, bool any, uint cut_s
             uint i = triangles.x + k;
             float t;
             vec2 bary;
-            if (intersect_triangle(ray_triangle(i), origin, dir, tmin, hit.t, t, bary) && !cut_out(i, bary, cut_seed)) {
+            RayTriangle tri = ray_triangle(i);
+            if (intersect_triangle(tri, origin, dir, tmin, hit.t, t, bary) && !cut_out(i, tri, bary, cut_seed)) {
                 hit.triangle = i;
                 hit.t = t;
                 hit.bary = bary;

@@ -4,9 +4,10 @@
 //!
 //! Two compressed eight-wide BVHs (CWBVH): the static meshes', built once, and the moving
 //! meshes', built again every frame at the frame's time (a rebuild over their triangles
-//! alone: they are few; a refit would keep a tree built for other positions). The nodes and triangles of both sit in
-//! the same buffers, the moving meshes' after the static ones', rewritten in the frame's
-//! command buffer from a staging buffer per frame in flight.
+//! alone: they are few; a refit would keep a tree built for other positions). The nodes
+//! and triangles of both sit in the same buffers, the moving meshes' after the static
+//! ones', rewritten in the frame's command buffer from a staging buffer per frame in
+//! flight.
 
 mod atlas;
 mod bvh;
@@ -29,7 +30,7 @@ use crate::scene::Scene;
 use crate::scene_gpu::{gpu_materials, upload_texture};
 use crate::vk::{
     memory_barrier, sampler_info, upload_buffer, Binding, Buffer, Context, Image, OneShot, Sampler,
-    SetWriter, TexelView,
+    SetWriter, TexelBuffer,
 };
 pub use bvh::{Bvh, Triangles};
 
@@ -50,15 +51,13 @@ pub struct BuildStats {
 
 /// The scene's triangles on the GPU, ready to cast rays against.
 pub struct SceneRays {
-    /// The buffers below as texel buffers (dropped before them).
-    views: Vec<(u32, TexelView)>,
     uniforms: Buffer,
-    nodes: Buffer,
-    triangles: Buffer,
-    shading: Buffer,
-    materials: Buffer,
-    emitters: Buffer,
-    textures: Buffer,
+    nodes: TexelBuffer,
+    triangles: TexelBuffer,
+    shading: TexelBuffer,
+    materials: TexelBuffer,
+    emitters: TexelBuffer,
+    textures: TexelBuffer,
     atlas: Image,
     /// Referenced by the sets the rays are written into.
     atlas_sampler: Sampler,
@@ -81,7 +80,8 @@ const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::COMPUTE;
 /// `int` in GLSL.
 const MAX_TRIANGLES: usize = 1 << 29;
 
-/// Refuses a BVH deeper than the traversal stack holds (it pushes a node per level at most).
+/// Refuses a BVH deeper than the traversal stack holds (it pushes a group of children per
+/// level at most).
 fn check_depth(depth: u32, what: &str) -> Result<()> {
     if depth >= layout::RAY_STACK_SIZE {
         bail!(
@@ -180,13 +180,10 @@ impl SceneRays {
             check_buffer_size(name, size, limit)?;
             let mut bytes = data.to_vec();
             bytes.resize(size as usize, 0);
-            upload_buffer(
-                ctx,
-                &one_shot,
-                name,
-                &bytes,
-                vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-            )
+            let usage =
+                vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            let buffer = upload_buffer(ctx, &one_shot, name, &bytes, usage)?;
+            TexelBuffer::new(name, buffer, TEXEL_FORMAT)
         };
         let nodes = sized(
             "ray BVH nodes",
@@ -274,23 +271,6 @@ impl SceneRays {
             &sampler_info(vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE),
         )?;
         Ok(Self {
-            views: [
-                (layout::BINDING_RAY_NODES, &nodes, "ray BVH nodes"),
-                (layout::BINDING_RAY_TRIANGLES, &triangles, "ray triangles"),
-                (
-                    layout::BINDING_RAY_SHADING,
-                    &shading,
-                    "ray triangle shading",
-                ),
-                (layout::BINDING_RAY_MATERIALS, &materials, "ray materials"),
-                (layout::BINDING_RAY_TEXTURES, &textures, "ray texture rects"),
-                (layout::BINDING_RAY_EMITTERS, &emitters, "ray emitters"),
-            ]
-            .into_iter()
-            .map(|(binding, buffer, name)| {
-                Ok((binding, TexelView::new(ctx, name, buffer, TEXEL_FORMAT)?))
-            })
-            .collect::<Result<_>>()?,
             uniforms,
             nodes,
             triangles,
@@ -318,7 +298,7 @@ impl SceneRays {
 
     /// Writes the ray-casting bindings into `set`.
     pub fn write_set(&self, set: vk::DescriptorSet) {
-        let mut writer = SetWriter::new(&self.ctx, set)
+        SetWriter::new(&self.ctx, set)
             .buffer(
                 layout::BINDING_RAY_UNIFORMS,
                 vk::DescriptorType::UNIFORM_BUFFER,
@@ -329,11 +309,14 @@ impl SceneRays {
                 self.atlas.view,
                 self.atlas_sampler.raw,
                 vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            );
-        for (binding, view) in &self.views {
-            writer = writer.texel_buffer(*binding, view.raw);
-        }
-        writer.apply();
+            )
+            .texel_buffer(layout::BINDING_RAY_NODES, self.nodes.view())
+            .texel_buffer(layout::BINDING_RAY_TRIANGLES, self.triangles.view())
+            .texel_buffer(layout::BINDING_RAY_SHADING, self.shading.view())
+            .texel_buffer(layout::BINDING_RAY_MATERIALS, self.materials.view())
+            .texel_buffer(layout::BINDING_RAY_TEXTURES, self.textures.view())
+            .texel_buffer(layout::BINDING_RAY_EMITTERS, self.emitters.view())
+            .apply();
     }
 
     /// Whether the scene has moving meshes, whose BVH [`Self::record_moving`] rebuilds.
@@ -367,15 +350,15 @@ impl SceneRays {
         ];
         let targets = [
             (
-                &self.nodes,
+                &self.nodes.buffer,
                 self.static_nodes as usize * std::mem::size_of::<BvhNode>(),
             ),
             (
-                &self.triangles,
+                &self.triangles.buffer,
                 self.static_triangles as usize * std::mem::size_of::<RayTriangle>(),
             ),
             (
-                &self.shading,
+                &self.shading.buffer,
                 self.static_triangles as usize * std::mem::size_of::<RayShading>(),
             ),
         ];
@@ -438,11 +421,17 @@ impl SceneRays {
     /// GPU memory of the ray-casting resources, by name.
     pub fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
         vec![
-            ("ray_bvh_nodes", self.nodes.size),
-            ("ray_triangles", self.triangles.size + self.shading.size),
+            ("ray_bvh_nodes", self.nodes.buffer.size),
+            (
+                "ray_triangles",
+                self.triangles.buffer.size + self.shading.buffer.size,
+            ),
             ("ray_texture_atlas", self.atlas.memory_bytes()),
-            ("ray_emitters", self.emitters.size),
-            ("ray_materials", self.materials.size + self.textures.size),
+            ("ray_emitters", self.emitters.buffer.size),
+            (
+                "ray_materials",
+                self.materials.buffer.size + self.textures.buffer.size,
+            ),
         ]
     }
 }

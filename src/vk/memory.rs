@@ -92,40 +92,37 @@ impl Buffer {
     }
 }
 
-/// A typed view of a buffer for `samplerBuffer` reads (a uniform texel buffer),
-/// destroyed when dropped (drop it before its buffer).
-pub struct TexelView {
-    pub raw: vk::BufferView,
-    ctx: Arc<Context>,
+/// A buffer read as a `samplerBuffer` (a uniform texel buffer): the buffer and its typed
+/// view, the view destroyed first.
+pub struct TexelBuffer {
+    view: vk::BufferView,
+    pub buffer: Buffer,
 }
 
-impl TexelView {
+impl TexelBuffer {
     /// The whole of `buffer` as texels of `format`; the buffer needs the
     /// `UNIFORM_TEXEL_BUFFER` usage.
-    pub fn new(
-        ctx: &Arc<Context>,
-        name: &str,
-        buffer: &Buffer,
-        format: vk::Format,
-    ) -> Result<Self> {
+    pub fn new(name: &str, buffer: Buffer, format: vk::Format) -> Result<Self> {
         let info = vk::BufferViewCreateInfo::default()
             .buffer(buffer.raw)
             .format(format)
             .offset(0)
             .range(vk::WHOLE_SIZE);
-        let raw = unsafe { ctx.device.create_buffer_view(&info, None) }
+        let ctx = &buffer.ctx;
+        let view = unsafe { ctx.device.create_buffer_view(&info, None) }
             .with_context(|| format!("creating the texel view of buffer {name}"))?;
-        ctx.set_name(raw, name);
-        Ok(Self {
-            raw,
-            ctx: ctx.clone(),
-        })
+        ctx.set_name(view, name);
+        Ok(Self { view, buffer })
+    }
+
+    pub fn view(&self) -> vk::BufferView {
+        self.view
     }
 }
 
-impl Drop for TexelView {
+impl Drop for TexelBuffer {
     fn drop(&mut self) {
-        unsafe { self.ctx.device.destroy_buffer_view(self.raw, None) };
+        unsafe { self.buffer.ctx.device.destroy_buffer_view(self.view, None) };
     }
 }
 

@@ -19,7 +19,7 @@ pub use context::{Context, ContextOptions, Features};
 pub use descriptors::{Binding, DescriptorSets, SetWriter};
 pub use memory::{
     is_depth_format, sampler_info, upload_buffer, Buffer, Image, ImageDesc, OwnedView, Sampler,
-    TexelView,
+    TexelBuffer,
 };
 pub use pipeline::{groups_2d, groups_3d, set_viewport, GraphicsDesc, Pipeline};
 pub use swapchain::{Acquired, Swapchain};
