@@ -257,19 +257,9 @@ mod tests {
         std::env::temp_dir().join(format!("voxcone-compare-{}-{name}", std::process::id()))
     }
 
-    /// The reference renders, from `VOXCONE_SHARED` or the `shared/` beside the checkout.
-    fn references() -> Option<PathBuf> {
-        let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-        let found = std::env::var_os("VOXCONE_SHARED")
-            .map(PathBuf::from)
-            .into_iter()
-            .chain([manifest.join("../shared"), manifest.join("../../shared")])
-            .map(|shared| shared.join("reference"))
-            .find(|dir| dir.join("compare.py").is_file());
-        if found.is_none() {
-            eprintln!("skipped: no shared/reference (set VOXCONE_SHARED to the shared folder)");
-        }
-        found
+    /// The reference renders.
+    fn references() -> PathBuf {
+        crate::scene::testing::shared_file("reference")
     }
 
     fn gradient(width: u32, height: u32, scale: f32) -> RgbImage {
@@ -437,8 +427,9 @@ mod tests {
 
     /// Matches shared/reference/cmp_cornell_point_direct.json, written by compare.py.
     #[test]
+    #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
     fn matches_compare_py_exr_vs_exr() {
-        let Some(dir) = references() else { return };
+        let dir = references();
         let m = compare(
             &dir.join("cornell_point.exr"),
             &dir.join("cornell_point_direct.exr"),
@@ -454,8 +445,9 @@ mod tests {
     /// compare.py sibenik_main.exr sibenik_main-modified.exr --exposure 2, on the copy this
     /// test writes: a darker left half plus a hashed per-pixel perturbation.
     #[test]
+    #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
     fn matches_compare_py_on_a_modified_copy() {
-        let Some(dir) = references() else { return };
+        let dir = references();
         let (image, _) = load_rgb(&dir.join("sibenik_main.exr")).unwrap();
         let width = image.width as usize;
         let modified: Vec<f32> = image
@@ -486,8 +478,9 @@ mod tests {
 
     /// compare.py cornell_area.png cornell_point.exr: PNG used as stored, no linear metrics.
     #[test]
+    #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
     fn matches_compare_py_png_vs_exr() {
-        let Some(dir) = references() else { return };
+        let dir = references();
         let m = compare(
             &dir.join("cornell_area.png"),
             &dir.join("cornell_point.exr"),

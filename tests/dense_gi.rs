@@ -39,8 +39,9 @@ fn floor_tint(path: &Path) -> (f32, f32) {
 }
 
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn cornell_point_dense_gi() {
-    let Some(shared) = shared() else { return };
+    let shared = shared();
     let reference = shared.join("reference/cornell_point.exr");
     let scene = shared.join("reference/cornell_point.scene.json");
     let dir = temp_dir("dense_gi");
@@ -84,8 +85,9 @@ fn cornell_point_dense_gi() {
 /// (LDR-FLIP 0.15 each) hold, Sibenik's with the margin it has (measured 0.1414 and
 /// 0.0864, BENCHMARKS.md).
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn sponza_and_sibenik_meet_quality_targets() {
-    let Some(shared) = shared() else { return };
+    let shared = shared();
     let dir = temp_dir("dense_gi_quality");
     for (name, bound) in [("sponza_main", 0.15), ("sibenik_main", 0.10)] {
         let out = dir.join(format!("{name}.exr"));
@@ -244,8 +246,9 @@ fn glass_passes_one_minus_d_of_the_light_behind() {
 
 /// Soft-shadow cones instead of shadow maps still match the path-traced direct light.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn shadow_cones_match_direct_reference() {
-    let Some(shared) = shared() else { return };
+    let shared = shared();
     let reference = shared.join("reference/cornell_point_direct.exr");
     let scene = shared.join("reference/cornell_point_direct.scene.json");
     let dir = temp_dir("shadow_cones");
@@ -298,8 +301,9 @@ fn shadow_cones_shade_lights_past_the_fourth() {
 
 /// Two renders of the same static frame are identical (no atomic-order flicker).
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn renders_are_deterministic() {
-    let Some(shared) = shared() else { return };
+    let shared = shared();
     let scene = shared.join("reference/cornell_point.scene.json");
     let dir = temp_dir("determinism");
     let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));

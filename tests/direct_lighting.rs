@@ -72,8 +72,9 @@ fn supersampled_pixels_are_means_of_a_larger_frame() {
 /// normal changes it by more than half, and a shadow leak lights the floor behind the
 /// blocks, each far outside these bounds.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn cornell_point_direct_matches_reference() {
-    let Some(shared) = shared() else { return };
+    let shared = shared();
     let reference = shared.join("reference/cornell_point_direct.exr");
     let scene = shared.join("reference/cornell_point_direct.scene.json");
     let out = temp_dir("cornell_direct").join("cornell.exr");
@@ -134,8 +135,9 @@ fn cornell_point_direct_matches_reference() {
 /// layers larger, bit for bit (the Cornell box with its point light, then with a
 /// directional light of zero irradiance beside it, which adds no light).
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn point_light_shadows_are_the_same_beside_a_larger_sun_map() {
-    let Some(shared) = shared() else { return };
+    let shared = shared();
     let dir = temp_dir("shadow_layers");
     let obj = shared.join("scenes/cornell_box/CornellBox-Original.obj");
     let point = format!(
@@ -167,8 +169,9 @@ fn point_light_shadows_are_the_same_beside_a_larger_sun_map() {
 /// Crytek Sponza at 512x512: textures (with mips), cut-outs and normal maps render with
 /// validation clean, and the sunlit floor shows texture detail.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn sponza_renders_with_textures() {
-    let Some(shared) = shared() else { return };
+    let shared = shared();
     let scene = shared.join("reference/sponza_main.scene.json");
     let out = temp_dir("sponza").join("sponza.exr");
     let output = voxcone(&[

@@ -277,10 +277,9 @@ fn compare(
 /// camera: the GPU finds the closest triangle the brute-force twin does (or one tied with
 /// it), at the same distance; and a hit exactly when any-hit queries see one.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn ray_caster_matches_brute_force_on_sponza() {
-    let Some(path) = shared_file("reference/sponza_main.scene.json") else {
-        return;
-    };
+    let path = shared_file("reference/sponza_main.scene.json");
     let scene = Scene::load(&path, &LoadOptions::default()).unwrap();
     let bounds = scene.bounds(0.0);
     let mut random = Random(0x9e37_79b9_7f4a_7c15);

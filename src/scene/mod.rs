@@ -330,37 +330,17 @@ pub(crate) mod testing {
     use std::path::{Path, PathBuf};
     use std::sync::atomic::{AtomicUsize, Ordering};
 
-    /// The shared scenes and references: `$VOXCONE_SHARED`, else `shared/` beside the
-    /// repository (this file is compiled both from the main crate and from a scratch crate
-    /// one level deeper). `None`, with the reason printed, when absent.
-    pub fn shared_dir() -> Option<PathBuf> {
-        let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-        let candidates: Vec<PathBuf> = std::env::var_os("VOXCONE_SHARED")
-            .map(PathBuf::from)
-            .into_iter()
-            .chain([manifest.join("../shared"), manifest.join("../../shared")])
-            .collect();
-        let found = candidates
-            .iter()
-            .find(|d| d.join("scenes").is_dir() && d.join("reference").is_dir());
-        if found.is_none() {
-            eprintln!(
-                "skipped: no shared scenes in {candidates:?} (set VOXCONE_SHARED to the folder \
-                 holding scenes/ and reference/)"
-            );
-        }
-        found.cloned()
+    /// The shared scenes and references that build.rs found. Only tests marked
+    /// `#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]` call it.
+    pub fn shared_dir() -> PathBuf {
+        // Reached without it only under `--include-ignored`.
+        let dir = option_env!("VOXCONE_SHARED_DIR");
+        PathBuf::from(dir.unwrap_or_else(|| panic!("built without ../shared (see build.rs)")))
     }
 
-    /// `path` under the shared folder; `None`, with the reason printed, when absent.
-    pub fn shared_file(path: &str) -> Option<PathBuf> {
-        let file = shared_dir()?.join(path);
-        if file.exists() {
-            Some(file)
-        } else {
-            eprintln!("skipped: {} is absent", file.display());
-            None
-        }
+    /// `path` under the shared folder.
+    pub fn shared_file(path: &str) -> PathBuf {
+        shared_dir().join(path)
     }
 
     /// A fresh folder under the system temp dir, removed again when dropped.

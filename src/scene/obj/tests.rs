@@ -214,8 +214,9 @@ fn errors_name_the_file() {
 }
 
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn cornell_box() {
-    let Some(shared) = shared_dir() else { return };
+    let shared = shared_dir();
     let obj = shared.join("scenes/cornell_box/CornellBox-Original.obj");
     let (meshes, materials, textures) = load(&obj, &LoadOptions::default()).unwrap();
     let triangles: usize = meshes.iter().map(|m| m.indices.len() / 3).sum();
@@ -242,8 +243,9 @@ fn cornell_box() {
 }
 
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn sponza() {
-    let Some(shared) = shared_dir() else { return };
+    let shared = shared_dir();
     let obj = shared.join("scenes/crytek_sponza/sponza.obj");
     let start = Instant::now();
     let (meshes, materials, textures) = load(&obj, &LoadOptions::default()).unwrap();

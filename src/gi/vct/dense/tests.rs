@@ -66,10 +66,9 @@ fn check_voxelization_by(scene: Scene, n: u32, voxelizer: Voxelizer) {
 }
 
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn voxelization_matches_cpu_on_cornell_box() {
-    let Some(path) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
-        return;
-    };
+    let path = shared_file("scenes/cornell_box/CornellBox-Original.obj");
     for n in [32, 64] {
         check_voxelization(Scene::load(&path, &LoadOptions::default()).unwrap(), n);
     }
@@ -111,10 +110,9 @@ fn halves(bytes: &[u8]) -> Vec<[f32; 4]> {
 /// below as downloaded (the first level: the base radiance, weighted by which way each
 /// voxel's lit face looks), within half-float rounding.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn filter_matches_cpu() {
-    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
-        return;
-    };
+    let path = shared_file("reference/cornell_point.scene.json");
     let options = LoadOptions::REFERENCE;
     let n = 32;
     let (ctx, renderer) = render(Scene::load(&path, &options).unwrap(), n);
@@ -162,10 +160,9 @@ fn filter_matches_cpu() {
 /// albedo) equal a fresh voxelization at the last time and a full re-voxelization of
 /// every frame, with either voxelizer.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn moving_mesh_leaves_no_voxels_behind() {
-    let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
-        return;
-    };
+    let cornell = shared_file("scenes/cornell_box/CornellBox-Original.obj");
     let dir = std::env::temp_dir().join(format!("voxcone-moving-{}", std::process::id()));
     let scene = moving_cube_scene(&cornell, &dir, false);
     for voxelizer in [Voxelizer::Raster, Voxelizer::Compute] {
@@ -207,10 +204,9 @@ fn check_moving_mesh(scene: Scene, voxelizer: Voxelizer) {
 /// Static geometry is voxelized once: later frames only shade it (a moving light needs
 /// no voxelization), unless every frame is a full update.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn static_voxels_are_voxelized_once() {
-    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
-        return;
-    };
+    let path = shared_file("reference/cornell_point.scene.json");
     let scene = Scene::load(&path, &LoadOptions::default()).unwrap();
     let passes = |full_update| {
         let (ctx, renderer) = render_at(scene.clone(), 32, &[0.0, 0.5], full_update);
@@ -233,10 +229,9 @@ fn static_voxels_are_voxelized_once() {
 /// triangles within each) give bit-identical volumes. A running RGBA8 average rounds
 /// differently in each order.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn voxel_means_do_not_depend_on_fragment_order() {
-    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
-        return;
-    };
+    let path = shared_file("reference/cornell_point.scene.json");
     let scene = Scene::load(&path, &LoadOptions::default()).unwrap();
     let mut reversed = scene.clone();
     reversed.meshes.reverse();
@@ -276,10 +271,9 @@ fn voxel_means_do_not_depend_on_fragment_order() {
 /// nothing else, and its dispatch covers it (synchronization validation cannot see
 /// storage-buffer hazards, so the buffer passes are checked by their result).
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn voxel_list_holds_exactly_the_occupied_voxels() {
-    let Some(path) = shared_file("reference/cornell_point.scene.json") else {
-        return;
-    };
+    let path = shared_file("reference/cornell_point.scene.json");
     let scene = Scene::load(&path, &LoadOptions::default()).unwrap();
     let n = 32;
     let (ctx, renderer) = render_at(scene, n, &[0.0, 0.5], true);

@@ -357,20 +357,21 @@ fn check_octree(scene: Scene, depth: u32, voxelizer: Voxelizer) {
     assert_eq!(ctx.validation_messages(), 0);
 }
 
-fn cornell() -> Option<Scene> {
-    let path = shared_file("scenes/cornell_box/CornellBox-Original.obj")?;
-    Some(Scene::load(&path, &LoadOptions::default()).unwrap())
+fn cornell() -> Scene {
+    let path = shared_file("scenes/cornell_box/CornellBox-Original.obj");
+    Scene::load(&path, &LoadOptions::default()).unwrap()
 }
 
 /// The Cornell box of the point-light reference, as the reference renders it.
-fn cornell_point() -> Option<Scene> {
-    let path = shared_file("reference/cornell_point.scene.json")?;
-    Some(Scene::load(&path, &LoadOptions::REFERENCE).unwrap())
+fn cornell_point() -> Scene {
+    let path = shared_file("reference/cornell_point.scene.json");
+    Scene::load(&path, &LoadOptions::REFERENCE).unwrap()
 }
 
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn octree_matches_cpu_octree_on_cornell_box() {
-    let Some(scene) = cornell() else { return };
+    let scene = cornell();
     for depth in [6, 7] {
         for voxelizer in [Voxelizer::Raster, Voxelizer::Compute] {
             check_octree(scene.clone(), depth, voxelizer);
@@ -379,10 +380,9 @@ fn octree_matches_cpu_octree_on_cornell_box() {
 }
 
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn octree_matches_cpu_octree_on_sponza() {
-    let Some(path) = shared_file("scenes/crytek_sponza/sponza.obj") else {
-        return;
-    };
+    let path = shared_file("scenes/crytek_sponza/sponza.obj");
     let options = LoadOptions::REFERENCE;
     // The rasterizer only: lavapipe runs the compute voxelizer's 262,087 workgroups for
     // minutes (the Cornell box's test covers it).
@@ -397,8 +397,9 @@ fn rgba(v: u32) -> [f32; 4] {
 /// Every leaf-brick voxel holds the mean of its fragments' albedo, normal and emission;
 /// voxels without fragments are empty.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn leaf_bricks_average_their_fragments() {
-    let Some(scene) = cornell() else { return };
+    let scene = cornell();
     let (ctx, renderer) = build(scene, 6, None);
     let svo = octree(&renderer).store();
     let d = download(svo);
@@ -458,8 +459,9 @@ fn leaf_bricks_average_their_fragments() {
 /// Pools far too small are reported, grown and the build runs again, giving the octree
 /// a build with room to spare gives.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn tiny_pools_grow_and_rebuild() {
-    let Some(scene) = cornell() else { return };
+    let scene = cornell();
     let tiny = Capacities {
         fragments: 64,
         nodes: 9,
@@ -563,10 +565,9 @@ fn brick_voxels(
 /// every brick's border holds the voxels of the neighbouring bricks (zero where the
 /// octree is empty, the edge voxel repeated at the grid's edge).
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn bricks_filter_and_borders_match_cpu() {
-    let Some(scene) = cornell_point() else {
-        return;
-    };
+    let scene = cornell_point();
     let depth = 6;
     let (ctx, renderer) = build_and_render(scene, depth, None, 1);
     let svo = octree(&renderer).store();
@@ -745,10 +746,9 @@ fn leaf_snapshot(r: &Renderer) -> (Vec<u32>, Vec<([u32; 3], u32)>) {
 /// static node's entry restored but where the moving cube reached it. With either
 /// voxelizer.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn moving_mesh_leaves_no_nodes_behind() {
-    let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
-        return;
-    };
+    let cornell = shared_file("scenes/cornell_box/CornellBox-Original.obj");
     let dir = std::env::temp_dir().join(format!("voxcone-svo-moving-{}", std::process::id()));
     let scene = moving_cube_scene(&cornell, &dir, false);
     for voxelizer in [Voxelizer::Raster, Voxelizer::Compute] {
@@ -855,10 +855,9 @@ fn leaf_direct(r: &Renderer) -> Vec<([u32; 3], [u16; 4])> {
 /// voxel's direct light equals what shading every voxel every frame gives, bit for bit;
 /// with shadow maps and with soft-shadow cones (a ray march through the voxels).
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn shading_what_moving_meshes_change_misses_nothing() {
-    let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
-        return;
-    };
+    let cornell = shared_file("scenes/cornell_box/CornellBox-Original.obj");
     let dir = std::env::temp_dir().join(format!("voxcone-svo-cull-{}", std::process::id()));
     let mut scene = moving_cube_scene(&cornell, &dir, false);
     scene.lights.push(Light {
@@ -910,10 +909,9 @@ fn shading_what_moving_meshes_change_misses_nothing() {
 /// `--full-update` voxelizes every mesh and rebuilds the octree every frame: the same
 /// octree as the build that keeps it.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn full_update_rebuilds_the_same_octree() {
-    let Some(scene) = cornell_point() else {
-        return;
-    };
+    let scene = cornell_point();
     let structure = Store::Octree { capacities: None };
     let (ctx, full) = render_frames(scene.clone(), gi_settings(64, structure, true), &[0.0, 0.5]);
     let (_, kept) = render_frames(scene, gi_settings(64, structure, false), &[0.0, 0.5]);
@@ -928,10 +926,9 @@ fn full_update_rebuilds_the_same_octree() {
 /// new bricks, and the light each voxel gathered is carried over by voxel: frames at a fixed time add one bounce
 /// each and converge to what one frame with every bounce gives.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn carried_light_converges_to_all_bounces() {
-    let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
-        return;
-    };
+    let cornell = shared_file("scenes/cornell_box/CornellBox-Original.obj");
     let dir = std::env::temp_dir().join(format!("voxcone-svo-carry-{}", std::process::id()));
     let scene = moving_cube_scene(&cornell, &dir, false);
     let settings = gi_settings(64, Store::Octree { capacities: None }, false);
@@ -1035,10 +1032,9 @@ fn check_update_lists_sliced(
 /// full filter would: after frames whose light moved, and after frames with it still.
 /// The first frames add bounces too.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn update_lists_filter_what_changed() {
-    let Some(scene) = cornell_point() else {
-        return;
-    };
+    let scene = cornell_point();
     for still in [0, 3] {
         let moved = |renderer: &mut Renderer, i: usize| {
             if i < 6 - still {
@@ -1054,10 +1050,9 @@ fn update_lists_filter_what_changed() {
 /// Around a moving mesh the update lists also take the nodes where it was and is: the
 /// nodes it leaves are filtered again, and their neighbours' borders copied again.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn update_lists_follow_moving_meshes() {
-    let Some(cornell) = shared_file("scenes/cornell_box/CornellBox-Original.obj") else {
-        return;
-    };
+    let cornell = shared_file("scenes/cornell_box/CornellBox-Original.obj");
     let dir = std::env::temp_dir().join(format!("voxcone-svo-lists-{}", std::process::id()));
     for glow in [false, true] {
         let scene = moving_cube_scene(&cornell, &dir, glow);
@@ -1079,10 +1074,9 @@ fn update_lists_follow_moving_meshes() {
 /// lists, no voxel's direct light changed: the same light would be stored again), and a
 /// light that moves starts them again.
 #[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn bounces_stop_once_converged() {
-    let Some(scene) = cornell_point() else {
-        return;
-    };
+    let scene = cornell_point();
     let settings = gi_settings(64, Store::Octree { capacities: None }, false);
     let frames = 40;
     let mut dispatched = Vec::new();
