@@ -83,13 +83,18 @@ pub struct CommonArgs {
     /// Tonemap for PNG and window output.
     #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
     pub tonemap: Tonemap,
-    /// Shadow map resolution of each view of a point or spot light.
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    /// Shadow map resolution of each view of a point or spot light: a power of two,
+    /// 16 to 8192.
+    #[arg(long, default_value_t = 1024, value_parser = parse_shadow_res)]
     pub shadow_res: u32,
     /// Shadow map resolution of a directional light, whose one view covers the whole
-    /// scene.
-    #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    /// scene: a power of two, 16 to 8192.
+    #[arg(long, default_value_t = 4096, value_parser = parse_shadow_res)]
     pub sun_shadow_res: u32,
+    /// The most memory the shadow maps may take, in MiB; with many lights the views'
+    /// resolutions are halved until they fit.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub shadow_budget: u32,
     /// The cone tracer's options (--gi dense, --gi octree).
     #[command(flatten)]
     pub vct: VctArgs,
@@ -251,6 +256,20 @@ pub fn parse_finite(text: &str) -> Result<f32> {
     Ok(value)
 }
 
+/// A shadow view's side: a power of two (the atlas packs tiles by halving,
+/// `ShadowAtlas`) from 16 to 8192.
+fn parse_shadow_res(text: &str) -> Result<u32> {
+    let value: u32 = text
+        .trim()
+        .parse()
+        .map_err(|_| anyhow!("expected a whole number, got {text:?}"))?;
+    let range = crate::passes::shadow::MIN_VIEW_RESOLUTION..=8192;
+    if !value.is_power_of_two() || !range.contains(&value) {
+        bail!("expected a power of two from 16 to 8192, got {value}");
+    }
+    Ok(value)
+}
+
 pub fn parse_size(text: &str) -> Result<(u32, u32)> {
     let Some((w, h)) = text.split_once(['x', 'X']) else {
         bail!("expected WIDTHxHEIGHT, e.g. 1280x720, got {text:?}");
@@ -332,6 +351,7 @@ impl CommonArgs {
             shadow_resolution: ShadowResolution {
                 local: self.shadow_res,
                 directional: self.sun_shadow_res,
+                budget_mib: self.shadow_budget,
             },
             cache_shadows: true,
             terms: Terms {

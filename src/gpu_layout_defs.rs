@@ -376,12 +376,12 @@ gpu_layout! {
         float texel_size,
         /// Shadow map layer index.
         uint layer,
-        /// Near plane distance (perspective).
-        float near,
-        /// Far plane distance (perspective).
-        float far,
-        /// Texels of the view along each side; it fills that corner of its layer (views of different lights may have different resolutions; the layers fit the largest).
+        /// Texels of the view along each side (views of different lights may have different resolutions; the layers fit the largest).
         uint resolution,
+        /// Texel column of the view's tile in its layer (ShadowAtlas).
+        uint offset_x,
+        /// Texel row of the view's tile in its layer.
+        uint offset_y,
         /// Unused.
         uint pad0,
         /// Unused.

@@ -123,14 +123,15 @@ impl Renderer {
             "nearest",
             &sampler_info(vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE),
         )?;
-        // Outside a shadow map's coverage reads as lit (border depth 1).
+        // Reverse Z (shadow::perspective): lit where the point is no farther from the light
+        // than the map's depth; outside a map's coverage reads as lit (border depth 0).
         let shadow_sampler = Sampler::new(
             ctx,
             "shadow compare",
             &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::CLAMP_TO_BORDER)
-                .border_color(vk::BorderColor::FLOAT_OPAQUE_WHITE)
+                .border_color(vk::BorderColor::FLOAT_TRANSPARENT_BLACK)
                 .compare_enable(true)
-                .compare_op(vk::CompareOp::LESS_OR_EQUAL),
+                .compare_op(vk::CompareOp::GREATER_OR_EQUAL),
         )?;
         let frames = (0..FRAMES_IN_FLIGHT)
             .map(|i| FrameData::new(ctx, i, &frame_sets, &scene, &shadow.map, &shadow_sampler))
@@ -366,8 +367,7 @@ impl Renderer {
         let cmd = frame.cmd;
         let uniforms = self.frame_uniforms(time_s);
         let lights = frame_data::gpu_lights(&self.scene, time_s);
-        let views: Vec<ShadowView> =
-            shadow::scene_views(&self.scene, time_s, self.settings.shadow_resolution);
+        let views: Vec<ShadowView> = shadow::scene_views(&self.scene, time_s, &self.shadow.atlas);
         let shadow_cones = self.gi_shades_direct();
         // The shadow maps and the G-buffer: a technique that casts its own camera rays
         // needs neither.

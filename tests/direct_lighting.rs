@@ -213,3 +213,46 @@ fn default_scene_renders() {
     let (image, _) = load_rgb(&out).unwrap();
     assert_eq!((image.width, image.height), (320, 240));
 }
+
+/// 1000 point lights asked for a 25 GB shadow map and failed (issue 22, item 9): their
+/// views are cut to fit the shadow budget, said on stderr, and the image is finite and
+/// lit by all of them.
+#[test]
+fn a_thousand_point_lights_render_within_the_shadow_budget() {
+    let dir = temp_dir("thousand_lights");
+    std::fs::write(
+        dir.join("quad.obj"),
+        "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 1 4 3 2\n",
+    )
+    .unwrap();
+    let mut scene = String::from(
+        "[camera]\nposition = [0, 2, 2]\ntarget = [0, 0, 0]\n[[mesh]]\npath = \"quad.obj\"\n",
+    );
+    for i in 0..1000 {
+        let (x, z) = ((i % 40) as f32 / 20.0 - 1.0, (i / 40) as f32 / 12.5 - 1.0);
+        scene += &format!(
+            "[[light]]\nkind = \"point\"\nposition = [{x}, 0.5, {z}]\nintensity = [0.001, 0.001, 0.001]\n"
+        );
+    }
+    let path = dir.join("lights.toml");
+    std::fs::write(&path, scene).unwrap();
+    let out = dir.join("lights.exr");
+    let output = voxcone(&[
+        "render",
+        path.to_str().unwrap(),
+        "--gi",
+        "off",
+        "--size",
+        "32x32",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_clean(&output);
+    let err = common::stderr(&output);
+    assert!(err.contains("shadow views cut to 128^2"), "{err}");
+    let (image, _) = load_rgb(&out).unwrap();
+    assert!(image.data.iter().all(|v| v.is_finite() && *v >= 0.0));
+    // The image's centre sees the quad's middle, under the lights.
+    let centre = ((16 * 32 + 16) * 3) as usize;
+    assert!(image.data[centre] > 0.0, "the quad is unlit");
+}

@@ -43,14 +43,18 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset, int 
     float texel_world = shadow_texel_world(view, p);
     vec4 clip = view.view_proj * vec4(p + n * (2.0 * texel_world + extra_offset), 1.0);
     vec3 ndc = clip.xyz / clip.w;
-    // The view fills the corner of its layer that its resolution asks for.
+    // The view is a tile of its layer (ShadowAtlas); its neighbours are other views, so
+    // every tap's bilinear footprint is clamped half a texel inside the tile.
     vec2 layer_texels = vec2(textureSize(shadow_map, 0).xy);
-    vec2 uv = (ndc.xy * 0.5 + 0.5) * float(view.resolution) / layer_texels;
-    vec2 texel_uv = 1.0 / layer_texels;
+    vec2 corner = vec2(view.offset_x, view.offset_y);
+    vec2 at = corner + (ndc.xy * 0.5 + 0.5) * float(view.resolution);
+    vec2 lo = corner + 0.5;
+    vec2 hi = corner + float(view.resolution) - 0.5;
     float sum = 0.0;
     for (int y = -pcf_radius; y <= pcf_radius; y++) {
         for (int x = -pcf_radius; x <= pcf_radius; x++) {
-            sum += texture(shadow_map, vec4(uv + vec2(x, y) * texel_uv, float(view.layer), ndc.z));
+            vec2 uv = clamp(at + vec2(x, y), lo, hi) / layer_texels;
+            sum += texture(shadow_map, vec4(uv, float(view.layer), ndc.z));
         }
     }
     float taps = float(2 * pcf_radius + 1);
@@ -67,7 +71,8 @@ vec3 light_arriving(GpuLight light, vec3 p, out vec3 to_light, out float dist) {
         e = light.intensity.rgb;
     } else {
         vec3 d = light.position.xyz - p;
-        float dist2 = max(dot(d, d), 1e-8);
+        // Only a light exactly on the point is clamped: no floor in scene units.
+        float dist2 = max(dot(d, d), 1e-30);
         dist = sqrt(dist2);
         to_light = d / dist;
         e = light.intensity.rgb / dist2;

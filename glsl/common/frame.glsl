@@ -16,6 +16,12 @@ layout(set = SET_FRAME, binding = BINDING_SHADOW_MAP) uniform sampler2DArrayShad
 
 const float PI = 3.14159265358979;
 
+// Whether a depth-buffer value is the sky: reverse Z clears to 0, the depth at infinity
+// (Camera::proj, gbuffer::DEPTH_CLEAR).
+bool is_sky(float depth) {
+    return depth <= 0.0;
+}
+
 // World position of the surface seen through `pixel` at depth-buffer value `depth`.
 vec3 pixel_position(ivec2 pixel, float depth) {
     vec2 ndc = (vec2(pixel) + 0.5) / vec2(frame.width, frame.height) * 2.0 - 1.0;

@@ -122,7 +122,9 @@ impl Viewer {
         let scene = load_scene(&args.common)?;
         let settings = args.common.render_settings(&scene.gi)?;
         let bounds = scene.bounds(0.0);
-        let scene_size = (bounds.max - bounds.min).length().max(1e-3);
+        let diagonal = (bounds.max - bounds.min).length();
+        // Camera speed follows the scene's units; a scene of one point moves by units.
+        let scene_size = if diagonal > 0.0 { diagonal } else { 1.0 };
         let renderer = Renderer::new(&ctx, scene, settings, swapchain.extent, swapchain.format)?;
         let acquired = (0..2)
             .map(|_| unsafe {

@@ -13,6 +13,9 @@ use crate::vk::{
 
 pub const COLOR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+/// Reverse Z (`Camera::proj`): the depth at infinity, which the sky keeps (`is_sky` in
+/// glsl/common/frame.glsl).
+pub const DEPTH_CLEAR: f32 = 0.0;
 pub const TRANSMISSION_FORMAT: vk::Format = vk::Format::R16G16_SFLOAT;
 const COLOR_FORMATS: [vk::Format; 4] = [
     COLOR_FORMAT,
@@ -168,7 +171,7 @@ impl GBufferPass {
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue {
                 depth_stencil: vk::ClearDepthStencilValue {
-                    depth: 1.0,
+                    depth: DEPTH_CLEAR,
                     stencil: 0,
                 },
             });

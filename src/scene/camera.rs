@@ -4,6 +4,9 @@ use glam::{Mat4, Vec3};
 
 use super::Aabb;
 
+/// The near plane's distance per unit of the scene's diagonal.
+const NEAR_PER_DIAGONAL: f32 = 1e-6;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
     pub position: Vec3,
@@ -11,12 +14,12 @@ pub struct Camera {
     pub up: Vec3,
     /// Full vertical field of view.
     pub fov_y_deg: f32,
+    /// The near plane; there is no far plane (reverse Z to infinity, see [`Camera::proj`]).
     pub near: f32,
-    pub far: f32,
 }
 
 impl Camera {
-    /// A camera with placeholder clip planes, to be set by [`Camera::fit_clip_planes`].
+    /// A camera with a placeholder near plane, to be set by [`Camera::fit_clip_planes`].
     pub fn look_at(position: Vec3, target: Vec3, up: Vec3, fov_y_deg: f32) -> Self {
         Self {
             position,
@@ -24,7 +27,6 @@ impl Camera {
             up,
             fov_y_deg,
             near: 0.01,
-            far: 100.0,
         }
     }
 
@@ -32,10 +34,15 @@ impl Camera {
         Mat4::look_at_rh(self.position, self.target, self.up)
     }
 
-    /// View to Vulkan clip space: depth 0..1, and y flipped so that image row 0 is the top
-    /// (Vulkan's NDC y points down the framebuffer).
+    /// View to Vulkan clip space with reverse Z to infinity: depth 1 at the near plane,
+    /// falling as near / distance towards 0 at infinity (the sky's cleared depth), and y
+    /// flipped so that image row 0 is the top (Vulkan's NDC y points down the
+    /// framebuffer). A float depth buffer then keeps the same relative precision at every
+    /// distance, so neither a near plane far inside the scene nor a far plane short of it
+    /// is needed, whatever the scene's units.
     pub fn proj(&self, aspect: f32) -> Mat4 {
-        let mut p = Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, self.near, self.far);
+        let mut p =
+            Mat4::perspective_infinite_reverse_rh(self.fov_y_deg.to_radians(), aspect, self.near);
         p.y_axis.y = -p.y_axis.y;
         p
     }
@@ -49,12 +56,11 @@ impl Camera {
         self.forward().cross(self.up).normalize()
     }
 
-    /// Clip planes for a scene with world `bounds`: near scales with the scene so depth
-    /// precision follows it; far leaves room to back away from the scene.
+    /// The near plane for a scene with world `bounds`: a millionth of its size, so that
+    /// it follows the scene's units and the camera can come that close to a wall (reverse
+    /// Z keeps depth precision relative to the distance, whatever the near plane).
     pub fn fit_clip_planes(&mut self, bounds: &Aabb) {
-        let diagonal = bounds.diagonal().max(1e-3);
-        self.near = (diagonal * 1e-3).max(1e-4);
-        self.far = 4.0 * ((bounds.center() - self.position).length() + diagonal);
+        self.near = bounds.diagonal().max(f32::MIN_POSITIVE) * NEAR_PER_DIAGONAL;
     }
 }
 
@@ -93,21 +99,28 @@ mod tests {
     }
 
     #[test]
-    fn depth_runs_from_zero_at_near_to_one_at_far() {
+    fn depth_runs_from_one_at_near_to_zero_at_infinity() {
         let mut camera = cornell_camera();
         camera.fit_clip_planes(&Aabb {
             min: Vec3::new(-1.0, 0.0, -1.0),
             max: Vec3::new(1.0, 2.0, 1.0),
         });
-        assert!((camera.near - 12f32.sqrt() * 1e-3).abs() < 1e-6);
-        assert!((camera.far - 4.0 * (3.9 + 12f32.sqrt())).abs() < 1e-4);
+        assert!((camera.near - 12f32.sqrt() * 1e-6).abs() < 1e-12);
         // In view space, to keep the camera's world position out of the rounding.
         let depth = |d: f32| camera.proj(1.5).project_point3(Vec3::new(0.0, 0.0, -d)).z;
-        assert!(depth(camera.near).abs() < 1e-6, "{}", depth(camera.near));
         assert!(
-            (depth(camera.far) - 1.0).abs() < 1e-6,
+            (depth(camera.near) - 1.0).abs() < 1e-6,
             "{}",
-            depth(camera.far)
+            depth(camera.near)
         );
+        for d in [1.0, 1e3, 1e6] {
+            let expected = camera.near / d;
+            assert!(
+                (depth(d) / expected - 1.0).abs() < 1e-5,
+                "{d}: {}",
+                depth(d)
+            );
+        }
+        assert!((0.0..1e-30).contains(&depth(1e30)), "{}", depth(1e30));
     }
 }

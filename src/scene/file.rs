@@ -338,7 +338,7 @@ pub(super) fn camera_from(
     );
     let forward = target - position;
     ensure!(
-        forward.length_squared() > 1e-12,
+        forward.length_squared() > 0.0,
         "camera.position and camera.target must differ"
     );
     ensure!(
@@ -353,7 +353,9 @@ pub(super) fn camera_from(
 fn framing_camera(bounds: &Aabb) -> Camera {
     const FOV_Y_DEG: f32 = 45.0;
     let center = bounds.center();
-    let radius = (bounds.diagonal() * 0.5).max(1e-3);
+    // In the scene's units, however small; a scene of one point gets a unit sphere.
+    let half = bounds.diagonal() * 0.5;
+    let radius = if half > 0.0 { half } else { 1.0 };
     let distance = radius / (FOV_Y_DEG * 0.5).to_radians().sin();
     let direction = Vec3::new(0.0, 0.25, 1.0).normalize();
     Camera::look_at(center + direction * distance, center, Vec3::Y, FOV_Y_DEG)

@@ -21,7 +21,7 @@ pub use memory::{
     is_depth_format, sampler_info, upload_buffer, Buffer, Image, ImageDesc, OwnedView, Sampler,
     TexelBuffer,
 };
-pub use pipeline::{groups_2d, groups_3d, set_viewport, GraphicsDesc, Pipeline};
+pub use pipeline::{groups_2d, groups_3d, set_viewport, set_viewport_rect, GraphicsDesc, Pipeline};
 pub use swapchain::{Acquired, Swapchain};
 pub use sync::{Frame, FrameRing};
 pub use timestamps::GpuTimer;

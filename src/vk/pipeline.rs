@@ -274,7 +274,9 @@ impl Pipeline {
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_format.is_some())
             .depth_write_enable(desc.depth_format.is_some())
-            .depth_compare_op(vk::CompareOp::LESS);
+            // Reverse Z everywhere (the camera's and the lights' projections): nearer is
+            // larger.
+            .depth_compare_op(vk::CompareOp::GREATER);
         let blend_attachments: Vec<_> = desc
             .color_formats
             .iter()
@@ -333,18 +335,27 @@ impl Pipeline {
 
 /// Sets a viewport and scissor covering `extent`.
 pub fn set_viewport(ctx: &Context, cmd: vk::CommandBuffer, extent: vk::Extent2D) {
+    set_viewport_rect(
+        ctx,
+        cmd,
+        vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent,
+        },
+    );
+}
+
+/// Viewport and scissor both `rect` (a tile of an atlas).
+pub fn set_viewport_rect(ctx: &Context, cmd: vk::CommandBuffer, rect: vk::Rect2D) {
     let viewport = vk::Viewport {
-        x: 0.0,
-        y: 0.0,
-        width: extent.width as f32,
-        height: extent.height as f32,
+        x: rect.offset.x as f32,
+        y: rect.offset.y as f32,
+        width: rect.extent.width as f32,
+        height: rect.extent.height as f32,
         min_depth: 0.0,
         max_depth: 1.0,
     };
-    let scissor = vk::Rect2D {
-        offset: vk::Offset2D::default(),
-        extent,
-    };
+    let scissor = rect;
     unsafe {
         ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
         ctx.device.cmd_set_scissor(cmd, 0, &[scissor]);

@@ -67,7 +67,8 @@ vec3 apply_normal_map(uint i, vec3 n, uint map, vec2 uv) {
     vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
     vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
     float len = max(dot(t, t), dot(b, b));
-    if (len < 1e-30) {
+    // No uv change along the triangle (relative to its edges, as in the G-buffer).
+    if (len <= 1e-20 * max(dot(tri.e1.xyz, tri.e1.xyz), dot(tri.e2.xyz, tri.e2.xyz))) {
         return n;
     }
     float scale = dot(n, cross(tri.e1.xyz, tri.e2.xyz)) < 0.0 ? -inversesqrt(len) : inversesqrt(len);

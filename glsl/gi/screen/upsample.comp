@@ -51,7 +51,7 @@ Taps upsample_taps(ivec2 pixel, vec3 p, vec3 n) {
         taps.weight[k] = 0.0;
         ivec2 sample_pixel = representative(low);
         float sample_depth = texelFetch(gbuffer_depth, sample_pixel, 0).r;
-        if (sample_depth >= 1.0) {
+        if (is_sky(sample_depth)) {
             continue;
         }
         vec3 q = pixel_position(sample_pixel, sample_depth);
@@ -103,7 +103,7 @@ void main() {
     // does not run); otherwise it adds to the lighting pass's direct light.
     bool shades = enabled(FLAG_SHADOW_CONES);
     float depth = texelFetch(gbuffer_depth, pixel, 0).r;
-    if (depth >= 1.0) {
+    if (is_sky(depth)) {
         if (frame.debug_view != DEBUG_NONE) {
             imageStore(screen_radiance, pixel, vec4(frame.debug_view == DEBUG_AO ? vec3(1.0) : vec3(0.0), 1.0));
         } else if (shades) {

@@ -30,7 +30,9 @@ vec3 apply_normal_map(vec3 n) {
     vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
     vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
     float len = max(dot(t, t), dot(b, b));
-    if (len < 1e-20) {
+    // No uv change across the pixel (len is |dp|^2 |duv|^2: relative to |dp|^2, so that
+    // the test does not depend on the scene's units).
+    if (len <= 1e-20 * max(dot(dp1, dp1), dot(dp2, dp2))) {
         return n;
     }
     float scale = dot(n, cross(dp1, dp2)) < 0.0 ? -inversesqrt(len) : inversesqrt(len);

@@ -16,7 +16,7 @@ void main() {
         return;
     }
     float depth = texelFetch(gbuffer_depth, pixel, 0).r;
-    if (depth >= 1.0) {
+    if (is_sky(depth)) {
         vec3 sky = (frame.flags & FLAG_EMISSION) != 0u ? frame.sky_radiance.rgb : vec3(0.0);
         imageStore(radiance_out, pixel, vec4(sky, 1.0));
         return;

@@ -27,7 +27,7 @@ void main() {
     }
     ivec2 pixel = representative(low);
     float depth = texelFetch(gbuffer_depth, pixel, 0).r;
-    if (depth >= 1.0) {
+    if (is_sky(depth)) {
         imageStore(indirect, low, vec4(0.0, 0.0, 0.0, 1.0));
         return;
     }
