@@ -72,7 +72,10 @@ Taps upsample_taps(ivec2 pixel, vec3 p, vec3 n) {
 // Defines `vec4 NAME(Taps taps, ivec2 offset)`: IMAGE upsampled (its samples at
 // `offset` from the reduced-resolution pixels), or `EMPTY` where no sample is on the
 // pixel's surface. Each image is read only where it is needed: on a CPU driver every load
-// counts. GLSL cannot pass an image to a function, hence one function per image.
+// counts. A tap of zero weight is not read at all: a sample that sees the sky writes only
+// the indirect image, and 0 times the stale NaN bits another image may hold there is NaN
+// (the Stanford bunny with --shadow-cones showed such pixels). GLSL cannot pass an image
+// to a function, hence one function per image.
 #define DEFINE_UPSAMPLED(NAME, IMAGE, EMPTY)                        \
     vec4 NAME(Taps taps, ivec2 offset) {                            \
         if (taps.total <= 1e-6) {                                   \
@@ -80,7 +83,9 @@ Taps upsample_taps(ivec2 pixel, vec3 p, vec3 n) {
         }                                                           \
         vec4 sum = vec4(0.0);                                       \
         for (int k = 0; k < 4; k++) {                               \
-            sum += taps.weight[k] * imageLoad(IMAGE, taps.low[k] + offset); \
+            if (taps.weight[k] > 0.0) {                             \
+                sum += taps.weight[k] * imageLoad(IMAGE, taps.low[k] + offset); \
+            }                                                       \
         }                                                           \
         return sum / taps.total;                                    \
     }
