@@ -38,6 +38,19 @@ pub struct BenchReport {
     /// GPU milliseconds per pass of the technique's preparation (the octree's build).
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub prepare_ms: BTreeMap<String, f64>,
+    /// The process's resident memory (MiB) after measured frame 1 and every 100th, and
+    /// after the last: a soak (`--frames 2000`) shows whether it stays flat. Empty where
+    /// the system does not say (`/proc/self/status`, Linux).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rss_mib: Vec<(u32, f64)>,
+}
+
+/// The resident set size in MiB, from `/proc/self/status` (`VmRSS: N kB`).
+fn resident_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
 }
 
 pub fn median(values: &mut [f64]) -> f64 {
@@ -86,6 +99,7 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
     let mut samples: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut totals = Vec::new();
     let mut walls = Vec::new();
+    let mut rss_mib = Vec::new();
     let total_frames = args.warmup + args.frames;
     let bounds = renderer.scene.bounds(args.common.time);
     let radius = 0.05 * (bounds.max - bounds.min).length();
@@ -111,6 +125,10 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
             continue;
         }
         walls.push(start.elapsed().as_secs_f64() * 1e3);
+        let measured = index - args.warmup + 1;
+        if measured == 1 || measured % 100 == 0 || measured == args.frames {
+            rss_mib.extend(resident_mib().map(|m| (measured, m)));
+        }
         // A pass that runs several times a frame (one per bounce) counts once, summed.
         let mut frame: BTreeMap<&str, f64> = BTreeMap::new();
         for (name, ms) in &renderer.timings {
@@ -167,6 +185,7 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
         memory_mib,
         stats: stats_map,
         prepare_ms: prepare_passes.into_iter().collect(),
+        rss_mib,
     };
     print_table(&report);
     if let Some(path) = &args.json {
@@ -196,4 +215,10 @@ fn print_table(report: &BenchReport) {
     }
     println!("{:<24} {:>10.3}", "total (GPU)", report.total_median_ms);
     println!("{:<24} {:>10.3}", "wall per frame", report.wall_median_ms);
+    if let (Some(first), Some(last)) = (report.rss_mib.first(), report.rss_mib.last()) {
+        println!(
+            "resident memory: {:.1} MiB after frame {}, {:.1} MiB after frame {}",
+            first.1, first.0, last.1, last.0
+        );
+    }
 }

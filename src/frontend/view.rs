@@ -40,6 +40,10 @@ struct Viewer {
     needs_resize: bool,
     /// Scene extent used to scale camera and light speed.
     scene_size: f32,
+    /// Swapchain recreations and frames skipped with nothing to present to (said at
+    /// exit: the resize-storm test reads them).
+    recreations: u64,
+    hidden_frames: u64,
 }
 
 struct App {
@@ -77,6 +81,13 @@ pub fn run(args: ViewArgs) -> Result<()> {
         return Err(error);
     }
     if let Some(viewer) = app.viewer.take() {
+        log::info!(
+            "viewer closed after {} frames: {} swapchain recreations, {} frames with nothing \
+             to present to",
+            app.frames,
+            viewer.recreations,
+            viewer.hidden_frames
+        );
         let ctx = viewer.ctx.clone();
         drop(viewer);
         check_validation(&ctx)?;
@@ -140,6 +151,8 @@ impl Viewer {
             ctx,
             needs_resize: false,
             scene_size,
+            recreations: 0,
+            hidden_frames: 0,
         })
     }
 
@@ -152,6 +165,7 @@ impl Viewer {
         })?;
         self.renderer.resize(self.swapchain.extent)?;
         self.needs_resize = false;
+        self.recreations += 1;
         Ok(())
     }
 
@@ -160,6 +174,7 @@ impl Viewer {
         let size = self.window.inner_size();
         if size.width == 0 || size.height == 0 {
             // Minimized: nothing to present to.
+            self.hidden_frames += 1;
             return Ok(());
         }
         if self.needs_resize
