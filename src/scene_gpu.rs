@@ -379,6 +379,25 @@ pub(crate) fn upload_texture(
     height: u32,
     mips: &[Vec<u8>],
 ) -> Result<Image> {
+    // A texture beyond the device's largest image starts at its first mip level that
+    // fits (each level halves, down to 1x1, so one always does).
+    let max = ctx.properties.limits.max_image_dimension2_d;
+    let skip = (0..mips.len())
+        .find(|&l| (width >> l).max(1) <= max && (height >> l).max(1) <= max)
+        .unwrap_or(mips.len() - 1);
+    if skip > 0 {
+        log::warn!(
+            "texture {name} is {width}x{height}, beyond the device's {max} texels: using its \
+             mip level {skip} ({}x{})",
+            (width >> skip).max(1),
+            (height >> skip).max(1)
+        );
+    }
+    let (width, height, mips) = (
+        (width >> skip).max(1),
+        (height >> skip).max(1),
+        &mips[skip..],
+    );
     let mut desc = ImageDesc::d2(
         format,
         width,

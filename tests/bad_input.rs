@@ -204,3 +204,543 @@ fn move_light_without_a_light() {
         &["--move-light", "no light"],
     );
 }
+
+/// How a corpus case must end.
+enum Outcome {
+    /// A non-zero exit whose error names each of these.
+    Error(&'static [&'static str]),
+    /// A clean render whose every value is finite and non-negative.
+    Image,
+}
+
+/// A case: its files (name, contents; the scene is the first), the options after
+/// `render SCENE -o out.exr`, and how it must end.
+struct Case {
+    name: &'static str,
+    files: Vec<(&'static str, Vec<u8>)>,
+    options: &'static [&'static str],
+    outcome: Outcome,
+}
+
+fn case(
+    name: &'static str,
+    files: &[(&'static str, &[u8])],
+    options: &'static [&'static str],
+    outcome: Outcome,
+) -> Case {
+    Case {
+        name,
+        files: files.iter().map(|(n, b)| (*n, b.to_vec())).collect(),
+        options,
+        outcome,
+    }
+}
+
+const QUAD_SCENE: &[u8] = b"[camera]\nposition = [0, 1, 2]\ntarget = [0, 0, 0]\n\
+    [[mesh]]\npath = \"m.obj\"\n[[light]]\nkind = \"point\"\nposition = [0, 1, 0.5]\n\
+    intensity = [1, 1, 1]\n";
+
+/// A TOML scene around a quad of material `a` from `m.mtl`, with `extra` appended.
+fn quad_case(
+    name: &'static str,
+    obj_body: &str,
+    mtl: &str,
+    options: &'static [&'static str],
+    outcome: Outcome,
+) -> Case {
+    Case {
+        name,
+        files: vec![
+            ("scene.toml", QUAD_SCENE.to_vec()),
+            (
+                "m.obj",
+                format!("mtllib m.mtl\nusemtl a\n{obj_body}").into_bytes(),
+            ),
+            ("m.mtl", format!("newmtl a\n{mtl}").into_bytes()),
+        ],
+        options,
+        outcome,
+    }
+}
+
+const QUAD: &str = "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+    f 1/1 4/4 3/3 2/2\n";
+
+fn png(width: u32, height: u32) -> Vec<u8> {
+    let image = image::RgbaImage::from_pixel(width, height, image::Rgba([200, 100, 50, 255]));
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    bytes.into_inner()
+}
+
+fn corpus() -> Vec<Case> {
+    use Outcome::{Error, Image};
+    let kd = "Kd 0.5 0.5 0.5\n";
+    let mut garbage = vec![0u8; 4096];
+    let mut state = 0x9e37_79b9_u32;
+    for byte in &mut garbage {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        *byte = state as u8;
+    }
+    let truncated_png = png(64, 64)[..100].to_vec();
+    let scene_json = |camera: &str, lights: &str| {
+        format!(
+            "{{\"obj\": \"m.obj\", \"resolution\": [16, 16], \"camera\": {camera}, \
+             \"lights\": {lights}}}"
+        )
+        .into_bytes()
+    };
+    let camera =
+        "{\"pos\": [0, 1, 2], \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov_y_deg\": 40}";
+    let point = "{\"point\": [{\"position\": [0, 1, 0], \"intensity_W_sr\": [1, 1, 1]}]}";
+    let json_case = |name, camera: &str, lights: &str, outcome| Case {
+        name,
+        files: vec![
+            ("scene.scene.json", scene_json(camera, lights)),
+            (
+                "m.obj",
+                format!("mtllib m.mtl\nusemtl a\n{QUAD}").into_bytes(),
+            ),
+            ("m.mtl", format!("newmtl a\n{kd}").into_bytes()),
+        ],
+        options: &[],
+        outcome,
+    };
+    vec![
+        // OBJ
+        quad_case("obj fine", QUAD, kd, &[], Image),
+        quad_case(
+            "obj truncated face",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2",
+            kd,
+            &[],
+            Error(&["m.obj"]),
+        ),
+        quad_case(
+            "obj index out of range",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+            kd,
+            &[],
+            Error(&["m.obj"]),
+        ),
+        quad_case(
+            "obj index zero",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n",
+            kd,
+            &[],
+            Error(&["m.obj"]),
+        ),
+        quad_case(
+            "obj negative indices",
+            "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nf -3 -1 -2\n",
+            kd,
+            &[],
+            Image,
+        ),
+        quad_case(
+            "obj negative index out of range",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -7\n",
+            kd,
+            &[],
+            Error(&["m.obj"]),
+        ),
+        quad_case(
+            "obj nan coordinate",
+            "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+            kd,
+            &[],
+            Error(&["m.obj"]),
+        ),
+        quad_case(
+            "obj infinite coordinate",
+            "v inf 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+            kd,
+            &[],
+            Error(&["m.obj"]),
+        ),
+        // A normal that is not finite and non-zero is replaced by the face's.
+        quad_case(
+            "obj nan normal",
+            &format!("{QUAD}vn nan 0 0\nf 1//1 2//1 3//1\n"),
+            kd,
+            &[],
+            Image,
+        ),
+        quad_case(
+            "obj degenerate faces only",
+            "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 1 1 1\n",
+            kd,
+            &[],
+            Error(&["no triangles"]),
+        ),
+        quad_case(
+            "obj degenerate face among good",
+            &format!("{QUAD}f 1 1 2\n"),
+            kd,
+            &[],
+            Image,
+        ),
+        case(
+            "obj binary garbage",
+            &[("scene.toml", QUAD_SCENE), ("m.obj", &garbage)],
+            &[],
+            Error(&["m.obj"]),
+        ),
+        case(
+            "obj empty",
+            &[("scene.toml", QUAD_SCENE), ("m.obj", b"")],
+            &[],
+            Error(&["no triangles"]),
+        ),
+        // MTL
+        quad_case(
+            "mtl single-value colour",
+            QUAD,
+            "Kd 0.5\nKa 1\nKs 0.1\n",
+            &[],
+            Image,
+        ),
+        quad_case(
+            "mtl nan colour",
+            QUAD,
+            "Kd nan 0.5 0.5\n",
+            &[],
+            Error(&["m.mtl", "Kd"]),
+        ),
+        quad_case(
+            "mtl infinite emission",
+            QUAD,
+            "Kd 0.5\nKe inf inf inf\n",
+            &[],
+            Error(&["m.mtl", "Ke"]),
+        ),
+        quad_case(
+            "mtl negative colour",
+            QUAD,
+            "Kd -5 -5 -5\n",
+            &[],
+            Error(&["m.mtl", "Kd"]),
+        ),
+        Case {
+            name: "mtl missing",
+            files: vec![
+                ("scene.toml", QUAD_SCENE.to_vec()),
+                (
+                    "m.obj",
+                    format!("mtllib gone.mtl\nusemtl a\n{QUAD}").into_bytes(),
+                ),
+            ],
+            options: &[],
+            outcome: Error(&["gone.mtl"]),
+        },
+        quad_case(
+            "mtl missing texture",
+            QUAD,
+            "Kd 1 1 1\nmap_Kd gone.png\n",
+            &[],
+            Error(&["gone.png"]),
+        ),
+        Case {
+            name: "mtl corrupt texture",
+            files: vec![
+                ("scene.toml", QUAD_SCENE.to_vec()),
+                (
+                    "m.obj",
+                    format!("mtllib m.mtl\nusemtl a\n{QUAD}").into_bytes(),
+                ),
+                ("m.mtl", b"newmtl a\nKd 1 1 1\nmap_Kd t.png\n".to_vec()),
+                ("t.png", truncated_png),
+            ],
+            options: &[],
+            outcome: Error(&["t.png"]),
+        },
+        Case {
+            name: "mtl texture",
+            files: vec![
+                ("scene.toml", QUAD_SCENE.to_vec()),
+                (
+                    "m.obj",
+                    format!("mtllib m.mtl\nusemtl a\n{QUAD}").into_bytes(),
+                ),
+                ("m.mtl", b"newmtl a\nKd 1 1 1\nmap_Kd t.png\n".to_vec()),
+                ("t.png", png(64, 32)),
+            ],
+            options: &[],
+            outcome: Image,
+        },
+        Case {
+            // Beyond the device's largest image (lavapipe: 16384): a smaller mip level.
+            name: "mtl huge texture",
+            files: vec![
+                ("scene.toml", QUAD_SCENE.to_vec()),
+                (
+                    "m.obj",
+                    format!("mtllib m.mtl\nusemtl a\n{QUAD}").into_bytes(),
+                ),
+                ("m.mtl", b"newmtl a\nKd 1 1 1\nmap_Kd t.png\n".to_vec()),
+                ("t.png", png(20000, 1)),
+            ],
+            options: &[],
+            outcome: Image,
+        },
+        quad_case(
+            "mtl texture is a directory",
+            QUAD,
+            "Kd 1 1 1\nmap_Kd .\n",
+            &[],
+            Error(&["is a directory"]),
+        ),
+        // TOML
+        case(
+            "toml syntax error",
+            &[("scene.toml", b"[[mesh]\npath = \"m.obj\"\n")],
+            &[],
+            Error(&["scene.toml", "line 1"]),
+        ),
+        case(
+            "toml type error",
+            &[("scene.toml", b"[[mesh]]\npath = 5\n")],
+            &[],
+            Error(&["scene.toml", "path"]),
+        ),
+        case(
+            "toml nan light",
+            &[
+                (
+                    "scene.toml",
+                    b"[[mesh]]\npath = \"m.obj\"\n[[light]]\n\
+kind = \"point\"\nposition = [nan, 1, 0]\n\
+intensity = [1, 1, 1]\n",
+                ),
+                ("m.obj", QUAD.as_bytes()),
+            ],
+            &[],
+            Error(&["light[0].position", "finite"]),
+        ),
+        case(
+            "toml negative intensity",
+            &[
+                (
+                    "scene.toml",
+                    b"[[mesh]]\npath = \"m.obj\"\n[[light]]\n\
+kind = \"point\"\nposition = [0, 1, 0]\n\
+intensity = [-1, 1, 1]\n",
+                ),
+                ("m.obj", QUAD.as_bytes()),
+            ],
+            &[],
+            Error(&["light[0].intensity"]),
+        ),
+        case(
+            "toml camera on its target",
+            &[
+                (
+                    "scene.toml",
+                    b"[camera]\nposition = [0, 1, 0]\n\
+target = [0, 1, 0]\n[[mesh]]\n\
+path = \"m.obj\"\n",
+                ),
+                ("m.obj", QUAD.as_bytes()),
+            ],
+            &[],
+            Error(&["camera.position and camera.target must differ"]),
+        ),
+        case(
+            "toml camera up along the view",
+            &[
+                (
+                    "scene.toml",
+                    b"[camera]\nposition = [0, 2, 0]\n\
+target = [0, 0, 0]\n[[mesh]]\n\
+path = \"m.obj\"\n",
+                ),
+                ("m.obj", QUAD.as_bytes()),
+            ],
+            &[],
+            Error(&["camera.up"]),
+        ),
+        case(
+            "toml zero light direction",
+            &[
+                (
+                    "scene.toml",
+                    b"[[mesh]]\npath = \"m.obj\"\n[[light]]\n\
+kind = \"directional\"\n\
+direction = [0, 0, 0]\n\
+irradiance = [1, 1, 1]\n",
+                ),
+                ("m.obj", QUAD.as_bytes()),
+            ],
+            &[],
+            Error(&["direction", "non-zero"]),
+        ),
+        case(
+            "toml zero mesh scale",
+            &[
+                ("scene.toml", b"[[mesh]]\npath = \"m.obj\"\nscale = 0\n"),
+                ("m.obj", QUAD.as_bytes()),
+            ],
+            &[],
+            Error(&["scale"]),
+        ),
+        case(
+            "toml no light",
+            &[
+                (
+                    "scene.toml",
+                    b"[camera]\nposition = [0, 1, 2]\n\
+target = [0, 0, 0]\n[[mesh]]\n\
+path = \"m.obj\"\n[sky]\n\
+radiance = [0.2, 0.2, 0.2]\n",
+                ),
+                ("m.obj", QUAD.as_bytes()),
+            ],
+            &["--gi", "dense", "--voxels", "16"],
+            Image,
+        ),
+        // Scene JSON
+        json_case("json fine", camera, point, Image),
+        json_case(
+            "json syntax error",
+            "{\"pos\": [0, 1, 2]",
+            point,
+            Error(&["scene.scene.json"]),
+        ),
+        json_case(
+            "json type error",
+            "{\"pos\": \"up\", \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov_y_deg\": 40}",
+            point,
+            Error(&["scene.scene.json", "expected an array", "column"]),
+        ),
+        json_case(
+            "json out-of-range number",
+            "{\"pos\": [1e999, 1, 2], \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov_y_deg\": 40}",
+            point,
+            Error(&["scene.scene.json"]),
+        ),
+        json_case(
+            "json fov 180",
+            "{\"pos\": [0, 1, 2], \"target\": [0, 0, 0], \"up\": [0, 1, 0], \"fov_y_deg\": 180}",
+            point,
+            Error(&["fov_y_deg"]),
+        ),
+        json_case(
+            "json negative intensity",
+            camera,
+            "{\"point\": [{\"position\": [0, 1, 0], \"intensity_W_sr\": [1, -1, 1]}]}",
+            Error(&["intensity_W_sr"]),
+        ),
+        // CLI extremes
+        quad_case(
+            "cli smallest frame",
+            QUAD,
+            kd,
+            &["--size", "1x1", "--supersample", "1"],
+            Image,
+        ),
+        quad_case(
+            "cli zero size",
+            QUAD,
+            kd,
+            &["--size", "0x16"],
+            Error(&["--size"]),
+        ),
+        quad_case(
+            "cli nan exposure",
+            QUAD,
+            kd,
+            &["--exposure", "nan"],
+            Error(&["--exposure"]),
+        ),
+        quad_case(
+            "cli huge voxels",
+            QUAD,
+            kd,
+            &["--gi", "dense", "--voxels", "4096"],
+            Error(&["voxels"]),
+        ),
+        quad_case(
+            "cli tiny shadow budget",
+            QUAD,
+            kd,
+            &["--shadow-budget", "0"],
+            Error(&["--shadow-budget"]),
+        ),
+        quad_case(
+            "cli shadow resolution not a power of two",
+            QUAD,
+            kd,
+            &["--shadow-res", "1000"],
+            Error(&["--shadow-res", "power of two"]),
+        ),
+        quad_case(
+            "cli every technique",
+            QUAD,
+            kd,
+            &["--gi", "svo", "--octree-depth", "6", "--shadow-cones"],
+            Image,
+        ),
+        quad_case("cli path", QUAD, kd, &["--gi", "path", "--spp", "4"], Image),
+    ]
+}
+
+/// Every case of the bad-input corpus ends in a clear error naming its cause or in a
+/// clean image finite and non-negative everywhere; none panics or hangs (each runs
+/// under a timeout through the harness's own).
+#[test]
+fn corpus_ends_in_an_error_or_a_finite_image() {
+    let root = temp_dir("corpus");
+    let (mut errors, mut images) = (0, 0);
+    for (i, case) in corpus().into_iter().enumerate() {
+        let dir = root.join(format!("{i:02}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (name, bytes) in &case.files {
+            std::fs::write(dir.join(name), bytes).unwrap();
+        }
+        let scene = dir.join(case.files[0].0);
+        let out = dir.join("out.exr");
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        if !case.options.contains(&"--size") {
+            args.extend(["--size", "16x16"]);
+        }
+        args.extend_from_slice(case.options);
+        let output = voxcone(&args);
+        let err = stderr(&output);
+        assert!(!err.contains("panicked"), "{}: panicked: {err}", case.name);
+        match case.outcome {
+            Outcome::Error(needles) => {
+                assert!(!output.status.success(), "{}: expected an error", case.name);
+                for needle in needles {
+                    assert!(
+                        err.contains(needle),
+                        "{}: error does not name {needle:?}: {err}",
+                        case.name
+                    );
+                }
+                errors += 1;
+            }
+            Outcome::Image => {
+                common::assert_clean(&output);
+                let (image, _) = voxcone::imageio::load_rgb(&out).unwrap();
+                let bad = image
+                    .data
+                    .iter()
+                    .filter(|v| !v.is_finite() || **v < 0.0)
+                    .count();
+                assert_eq!(bad, 0, "{}: {bad} non-finite or negative values", case.name);
+                images += 1;
+            }
+        }
+    }
+    eprintln!(
+        "corpus: {} cases, {errors} clear errors, {images} correct images",
+        errors + images
+    );
+}

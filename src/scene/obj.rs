@@ -393,6 +393,12 @@ struct TextureRequests {
 
 impl TextureRequests {
     fn request(&mut self, path: PathBuf, kind: TextureKind, material: &str) -> Result<u32> {
+        if path.is_dir() {
+            bail!(
+                "texture {} of material {material:?} is a directory, not an image",
+                path.display()
+            );
+        }
         if !path.is_file() {
             bail!(
                 "texture {} of material {material:?} not found",
