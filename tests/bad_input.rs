@@ -240,7 +240,8 @@ const QUAD_SCENE: &[u8] = b"[camera]\nposition = [0, 1, 2]\ntarget = [0, 0, 0]\n
     [[mesh]]\npath = \"m.obj\"\n[[light]]\nkind = \"point\"\nposition = [0, 1, 0.5]\n\
     intensity = [1, 1, 1]\n";
 
-/// A TOML scene around a quad of material `a` from `m.mtl`, with `extra` appended.
+/// `QUAD_SCENE` around `m.obj` holding `obj_body` (material `a`, whose MTL statements
+/// are `mtl`).
 fn quad_case(
     name: &'static str,
     obj_body: &str,
@@ -271,6 +272,31 @@ fn png(width: u32, height: u32) -> Vec<u8> {
     let mut bytes = std::io::Cursor::new(Vec::new());
     image.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
     bytes.into_inner()
+}
+
+/// A TOML scene `text` around the quad `m.obj` (no MTL).
+fn toml_case(
+    name: &'static str,
+    text: &str,
+    options: &'static [&'static str],
+    outcome: Outcome,
+) -> Case {
+    Case {
+        name,
+        files: vec![
+            ("scene.toml", text.as_bytes().to_vec()),
+            ("m.obj", QUAD.as_bytes().to_vec()),
+        ],
+        options,
+        outcome,
+    }
+}
+
+/// The quad with the texture `t.png` of `bytes` as its `map_Kd`.
+fn texture_case(name: &'static str, bytes: Vec<u8>, outcome: Outcome) -> Case {
+    let mut case = quad_case(name, QUAD, "Kd 1 1 1\nmap_Kd t.png\n", &[], outcome);
+    case.files.push(("t.png", bytes));
+    case
 }
 
 fn corpus() -> Vec<Case> {
@@ -442,49 +468,10 @@ fn corpus() -> Vec<Case> {
             &[],
             Error(&["gone.png"]),
         ),
-        Case {
-            name: "mtl corrupt texture",
-            files: vec![
-                ("scene.toml", QUAD_SCENE.to_vec()),
-                (
-                    "m.obj",
-                    format!("mtllib m.mtl\nusemtl a\n{QUAD}").into_bytes(),
-                ),
-                ("m.mtl", b"newmtl a\nKd 1 1 1\nmap_Kd t.png\n".to_vec()),
-                ("t.png", truncated_png),
-            ],
-            options: &[],
-            outcome: Error(&["t.png"]),
-        },
-        Case {
-            name: "mtl texture",
-            files: vec![
-                ("scene.toml", QUAD_SCENE.to_vec()),
-                (
-                    "m.obj",
-                    format!("mtllib m.mtl\nusemtl a\n{QUAD}").into_bytes(),
-                ),
-                ("m.mtl", b"newmtl a\nKd 1 1 1\nmap_Kd t.png\n".to_vec()),
-                ("t.png", png(64, 32)),
-            ],
-            options: &[],
-            outcome: Image,
-        },
-        Case {
-            // Beyond the device's largest image (lavapipe: 16384): a smaller mip level.
-            name: "mtl huge texture",
-            files: vec![
-                ("scene.toml", QUAD_SCENE.to_vec()),
-                (
-                    "m.obj",
-                    format!("mtllib m.mtl\nusemtl a\n{QUAD}").into_bytes(),
-                ),
-                ("m.mtl", b"newmtl a\nKd 1 1 1\nmap_Kd t.png\n".to_vec()),
-                ("t.png", png(20000, 1)),
-            ],
-            options: &[],
-            outcome: Image,
-        },
+        texture_case("mtl corrupt texture", truncated_png, Error(&["t.png"])),
+        texture_case("mtl texture", png(64, 32), Image),
+        // Beyond the device's largest image (lavapipe: 16384): a smaller mip level.
+        texture_case("mtl huge texture", png(20000, 1), Image),
         quad_case(
             "mtl texture is a directory",
             QUAD,
@@ -505,98 +492,74 @@ fn corpus() -> Vec<Case> {
             &[],
             Error(&["scene.toml", "path"]),
         ),
-        case(
+        toml_case(
             "toml nan light",
-            &[
-                (
-                    "scene.toml",
-                    b"[[mesh]]\npath = \"m.obj\"\n[[light]]\n\
-kind = \"point\"\nposition = [nan, 1, 0]\n\
-intensity = [1, 1, 1]\n",
-                ),
-                ("m.obj", QUAD.as_bytes()),
-            ],
+            "[[mesh]]\n\
+             path = \"m.obj\"\n\
+             [[light]]\n\
+             kind = \"point\"\n\
+             position = [nan, 1, 0]\n\
+             intensity = [1, 1, 1]\n",
             &[],
             Error(&["light[0].position", "finite"]),
         ),
-        case(
+        toml_case(
             "toml negative intensity",
-            &[
-                (
-                    "scene.toml",
-                    b"[[mesh]]\npath = \"m.obj\"\n[[light]]\n\
-kind = \"point\"\nposition = [0, 1, 0]\n\
-intensity = [-1, 1, 1]\n",
-                ),
-                ("m.obj", QUAD.as_bytes()),
-            ],
+            "[[mesh]]\n\
+             path = \"m.obj\"\n\
+             [[light]]\n\
+             kind = \"point\"\n\
+             position = [0, 1, 0]\n\
+             intensity = [-1, 1, 1]\n",
             &[],
             Error(&["light[0].intensity"]),
         ),
-        case(
+        toml_case(
             "toml camera on its target",
-            &[
-                (
-                    "scene.toml",
-                    b"[camera]\nposition = [0, 1, 0]\n\
-target = [0, 1, 0]\n[[mesh]]\n\
-path = \"m.obj\"\n",
-                ),
-                ("m.obj", QUAD.as_bytes()),
-            ],
+            "[camera]\n\
+             position = [0, 1, 0]\n\
+             target = [0, 1, 0]\n\
+             [[mesh]]\n\
+             path = \"m.obj\"\n",
             &[],
             Error(&["camera.position and camera.target must differ"]),
         ),
-        case(
+        toml_case(
             "toml camera up along the view",
-            &[
-                (
-                    "scene.toml",
-                    b"[camera]\nposition = [0, 2, 0]\n\
-target = [0, 0, 0]\n[[mesh]]\n\
-path = \"m.obj\"\n",
-                ),
-                ("m.obj", QUAD.as_bytes()),
-            ],
+            "[camera]\n\
+             position = [0, 2, 0]\n\
+             target = [0, 0, 0]\n\
+             [[mesh]]\n\
+             path = \"m.obj\"\n",
             &[],
             Error(&["camera.up"]),
         ),
-        case(
+        toml_case(
             "toml zero light direction",
-            &[
-                (
-                    "scene.toml",
-                    b"[[mesh]]\npath = \"m.obj\"\n[[light]]\n\
-kind = \"directional\"\n\
-direction = [0, 0, 0]\n\
-irradiance = [1, 1, 1]\n",
-                ),
-                ("m.obj", QUAD.as_bytes()),
-            ],
+            "[[mesh]]\n\
+             path = \"m.obj\"\n\
+             [[light]]\n\
+             kind = \"directional\"\n\
+             direction = [0, 0, 0]\n\
+             irradiance = [1, 1, 1]\n",
             &[],
             Error(&["direction", "non-zero"]),
         ),
-        case(
+        toml_case(
             "toml zero mesh scale",
-            &[
-                ("scene.toml", b"[[mesh]]\npath = \"m.obj\"\nscale = 0\n"),
-                ("m.obj", QUAD.as_bytes()),
-            ],
+            "[[mesh]]\npath = \"m.obj\"\nscale = 0\n",
             &[],
             Error(&["scale"]),
         ),
-        case(
+        toml_case(
             "toml no light",
-            &[
-                (
-                    "scene.toml",
-                    b"[camera]\nposition = [0, 1, 2]\n\
-target = [0, 0, 0]\n[[mesh]]\n\
-path = \"m.obj\"\n[sky]\n\
-radiance = [0.2, 0.2, 0.2]\n",
-                ),
-                ("m.obj", QUAD.as_bytes()),
-            ],
+            "[camera]\n\
+             position = [0, 1, 2]\n\
+             target = [0, 0, 0]\n\
+             [[mesh]]\n\
+             path = \"m.obj\"\n\
+             [sky]\n\
+             radiance = [0.2, 0.2, 0.2]\n",
             &["--gi", "dense", "--voxels", "16"],
             Image,
         ),
