@@ -132,7 +132,7 @@ fn cornell_point_direct_matches_reference() {
 
 /// Shadow maps of different resolutions share the map's layers: a point light's six views
 /// (1024 texels) keep their shadows when a directional light's view (4096) makes the
-/// layers larger, bit for bit (the Cornell box with its point light, then with a
+/// layers larger, to float rounding (the Cornell box with its point light, then with a
 /// directional light of zero irradiance beside it, which adds no light).
 #[test]
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
@@ -155,15 +155,18 @@ fn point_light_shadows_are_the_same_beside_a_larger_sun_map() {
         common::render_256(&scene, &["--gi", "off"], &out);
         images.push(load_rgb(&out).unwrap().0.data);
     }
-    let differing = images[0]
+    // The point light's faces are tiles of the sun's 4096^2 layers then (ShadowAtlas),
+    // sampled at coordinates rounded on a finer grid: measured 1.6e-5 at most (of 6.6),
+    // where a tap leaking across a tile's edge would move a pixel by 1/25 of its light.
+    let largest = images[0]
         .iter()
         .zip(&images[1])
-        .filter(|(a, b)| a != b)
-        .count();
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
     let shadowed = images[0].chunks_exact(3).filter(|p| p == &[0.0; 3]).count();
-    eprintln!("{differing} values differ; {shadowed} pixels unlit");
+    eprintln!("largest difference {largest}; {shadowed} pixels unlit");
     assert!(shadowed > 1000, "nothing unlit to compare");
-    assert_eq!(differing, 0);
+    assert!(largest <= 1e-4, "largest difference {largest}");
 }
 
 /// Crytek Sponza at 512x512: textures (with mips), cut-outs and normal maps render with
