@@ -292,6 +292,14 @@ fn toml_case(
     }
 }
 
+/// A TOML scene of the quad and one point light at `position` of `intensity`.
+fn point_light(position: &str, intensity: &str) -> String {
+    format!(
+        "[[mesh]]\npath = \"m.obj\"\n[[light]]\nkind = \"point\"\n\
+         position = {position}\nintensity = {intensity}\n"
+    )
+}
+
 /// The quad with the texture `t.png` of `bytes` as its `map_Kd`.
 fn texture_case(name: &'static str, bytes: Vec<u8>, outcome: Outcome) -> Case {
     let mut case = quad_case(name, QUAD, "Kd 1 1 1\nmap_Kd t.png\n", &[], outcome);
@@ -494,23 +502,13 @@ fn corpus() -> Vec<Case> {
         ),
         toml_case(
             "toml nan light",
-            "[[mesh]]\n\
-             path = \"m.obj\"\n\
-             [[light]]\n\
-             kind = \"point\"\n\
-             position = [nan, 1, 0]\n\
-             intensity = [1, 1, 1]\n",
+            &point_light("[nan, 1, 0]", "[1, 1, 1]"),
             &[],
             Error(&["light[0].position", "finite"]),
         ),
         toml_case(
             "toml negative intensity",
-            "[[mesh]]\n\
-             path = \"m.obj\"\n\
-             [[light]]\n\
-             kind = \"point\"\n\
-             position = [0, 1, 0]\n\
-             intensity = [-1, 1, 1]\n",
+            &point_light("[0, 1, 0]", "[-1, 1, 1]"),
             &[],
             Error(&["light[0].intensity"]),
         ),

@@ -240,16 +240,7 @@ fn a_thousand_point_lights_render_within_the_shadow_budget() {
     let path = dir.join("lights.toml");
     std::fs::write(&path, scene).unwrap();
     let out = dir.join("lights.exr");
-    let output = voxcone(&[
-        "render",
-        path.to_str().unwrap(),
-        "--gi",
-        "off",
-        "--size",
-        "32x32",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let output = common::run_render(&path, &["--gi", "off", "--size", "32x32"], &out);
     assert_clean(&output);
     let err = common::stderr(&output);
     assert!(err.contains("shadow views cut to 128^2"), "{err}");

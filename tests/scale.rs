@@ -7,6 +7,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{render, temp_dir};
+use voxcone::compare::{compare, CompareOptions};
 use voxcone::imageio::{load_rgb, RgbImage};
 
 /// A floor, two walls (one red) and a box on the floor, at unit scale.
@@ -60,16 +61,6 @@ fn render_image(scene: &Path, options: &[&str], out: &Path) -> RgbImage {
     image
 }
 
-fn rmse(a: &RgbImage, b: &RgbImage) -> f32 {
-    let sum: f64 = a
-        .data
-        .iter()
-        .zip(&b.data)
-        .map(|(x, y)| f64::from(x - y).powi(2))
-        .sum();
-    (sum / a.data.len() as f64).sqrt() as f32
-}
-
 fn mean(image: &RgbImage) -> f32 {
     image.data.iter().map(|&v| f64::from(v)).sum::<f64>() as f32 / image.data.len() as f32
 }
@@ -85,12 +76,16 @@ fn the_same_scene_at_every_scale_renders_the_same_image() {
         let options = [&["--gi", gi][..], extra].concat();
         let at = |scale: f32| {
             let scene = room(&dir, scale, camera, scale);
-            render_image(&scene, &options, &dir.join(format!("{gi}_{scale:e}.exr")))
+            let out = dir.join(format!("{gi}_{scale:e}.exr"));
+            let image = render_image(&scene, &options, &out);
+            (out, image)
         };
-        let unit = at(1.0);
-        let brightness = mean(&unit);
+        let (unit, image) = at(1.0);
+        let brightness = mean(&image);
         for scale in [1e-5, 1e-3, 1e3, 1e5] {
-            let relative = rmse(&unit, &at(scale)) / brightness;
+            let (out, _) = at(scale);
+            let metrics = compare(&unit, &out, &CompareOptions::default()).unwrap();
+            let relative = metrics.rmse_linear.unwrap() / brightness;
             eprintln!("--gi {gi}, scale {scale:e}: RMSE / mean {relative:.2e}");
             assert!(relative <= 1e-3, "--gi {gi} at scale {scale:e}: {relative}");
         }
