@@ -25,6 +25,8 @@ gpu_layout! {
         BINDING_COVERAGE_TEXTURE = 2;
         /// set 1: tangent-space normal map, `sampler2D` (white if none).
         BINDING_NORMAL_TEXTURE = 3;
+        /// set 1: emission texture, `sampler2D` (white if none).
+        BINDING_EMISSION_TEXTURE = 4;
         /// A material's texture index meaning "no texture".
         NO_TEXTURE = 0xFFFFFFFF;
 
@@ -404,8 +406,8 @@ gpu_layout! {
         uint coverage_texture,
         /// Tangent-space normal map or `NO_TEXTURE`.
         uint normal_texture,
-        /// Unused, keeps the struct a multiple of 16 bytes.
-        uint pad,
+        /// Emission texture (multiplies `emission.rgb`) or `NO_TEXTURE`.
+        uint emission_texture,
     }
 
     /// The voxel grid (dense, or the octree's effective grid) and the cone settings.

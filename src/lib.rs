@@ -12,6 +12,7 @@ pub mod gi;
 pub mod gpu_layout;
 pub mod imageio;
 pub mod passes;
+pub mod progress;
 pub mod ray;
 pub mod renderer;
 pub mod scene;

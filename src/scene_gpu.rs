@@ -182,13 +182,13 @@ pub fn gpu_materials(scene: &Scene) -> Vec<GpuMaterial> {
             albedo_texture: texture_index(m.albedo_texture),
             coverage_texture: texture_index(m.coverage_texture),
             normal_texture: texture_index(m.normal_texture),
-            pad: 0,
+            emission_texture: texture_index(m.emission_texture),
         })
         .collect()
 }
 
 impl GpuScene {
-    pub fn bindings() -> [Binding; 4] {
+    pub fn bindings() -> [Binding; 5] {
         let stages = vk::ShaderStageFlags::ALL;
         let sampled = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
         [
@@ -200,6 +200,7 @@ impl GpuScene {
             Binding::new(layout::BINDING_ALBEDO_TEXTURE, sampled, stages),
             Binding::new(layout::BINDING_COVERAGE_TEXTURE, sampled, stages),
             Binding::new(layout::BINDING_NORMAL_TEXTURE, sampled, stages),
+            Binding::new(layout::BINDING_EMISSION_TEXTURE, sampled, stages),
         ]
     }
 
@@ -320,6 +321,12 @@ impl GpuScene {
                     .sampled_image(
                         layout::BINDING_NORMAL_TEXTURE,
                         texture_view(m.normal_texture),
+                        sampler.raw,
+                        layout_ro,
+                    )
+                    .sampled_image(
+                        layout::BINDING_EMISSION_TEXTURE,
+                        texture_view(m.emission_texture),
                         sampler.raw,
                         layout_ro,
                     )

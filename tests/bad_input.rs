@@ -307,6 +307,32 @@ fn texture_case(name: &'static str, bytes: Vec<u8>, outcome: Outcome) -> Case {
     case
 }
 
+/// The quad's geometry as a glTF buffer: four positions (y = 0, facing up), six indices.
+fn gltf_quad_bin() -> Vec<u8> {
+    let positions: [f32; 12] = [-1., 0., -1., -1., 0., 1., 1., 0., 1., 1., 0., -1.];
+    let indices: [u32; 6] = [0, 1, 2, 0, 2, 3];
+    let mut bin: Vec<u8> = positions.iter().flat_map(|v| v.to_le_bytes()).collect();
+    bin.extend(indices.iter().flat_map(|v| v.to_le_bytes()));
+    bin
+}
+
+/// A glTF of the quad whose buffer is at `uri`, with `count` positions and the required
+/// extensions `required`.
+fn gltf_quad(uri: &str, count: u32, required: &str) -> Vec<u8> {
+    format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
+        "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}],
+        "buffers": [{{"uri": "{uri}", "byteLength": 72}}],
+        "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 48}},
+                        {{"buffer": 0, "byteOffset": 48, "byteLength": 24}}],
+        "accessors": [{{"bufferView": 0, "componentType": 5126, "count": {count}, "type": "VEC3",
+                        "min": [-1, 0, -1], "max": [1, 0, 1]}},
+                      {{"bufferView": 1, "componentType": 5125, "count": 6, "type": "SCALAR"}}],
+        "extensionsUsed": [{required}], "extensionsRequired": [{required}]}}"#
+    )
+    .into_bytes()
+}
+
 fn corpus() -> Vec<Case> {
     use Outcome::{Error, Image};
     let kd = "Kd 0.5 0.5 0.5\n";
@@ -342,7 +368,70 @@ fn corpus() -> Vec<Case> {
         options: &[],
         outcome,
     };
-    vec![
+    let bin = gltf_quad_bin();
+    let data_uri = {
+        use base64::Engine as _;
+        format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&bin)
+        )
+    };
+    let gltf_case = |name, gltf: Vec<u8>, outcome| Case {
+        name,
+        files: vec![("g.gltf", gltf), ("g.bin", bin.clone())],
+        options: &[],
+        outcome,
+    };
+    let draco = "\"KHR_draco_mesh_compression\"";
+    let gltf_cases = vec![
+        gltf_case("gltf fine", gltf_quad("g.bin", 4, ""), Image),
+        gltf_case("gltf data uri", gltf_quad(&data_uri, 4, ""), Image),
+        gltf_case(
+            "gltf truncated",
+            gltf_quad("g.bin", 4, "")[..120].to_vec(),
+            Error(&["g.gltf", "cannot parse"]),
+        ),
+        gltf_case(
+            "gltf missing bin",
+            gltf_quad("absent.bin", 4, ""),
+            Error(&["g.gltf", "absent.bin) not found"]),
+        ),
+        gltf_case(
+            "gltf accessor past its view",
+            gltf_quad("g.bin", 40, ""),
+            Error(&["g.gltf", "accessor 0"]),
+        ),
+        gltf_case(
+            "gltf unsupported extension",
+            gltf_quad("g.bin", 4, draco),
+            Error(&["g.gltf", "KHR_draco_mesh_compression"]),
+        ),
+        case(
+            "glb garbage",
+            &[("g.glb", &garbage)],
+            &[],
+            Error(&["g.glb", "cannot parse"]),
+        ),
+        Case {
+            name: "gltf in a toml scene",
+            files: vec![
+                (
+                    "scene.toml",
+                    format!(
+                        "{}[[mesh]]\npath = \"g.gltf\"\n",
+                        point_light("[0, 1, 0]", "[1, 1, 1]")
+                    )
+                    .into_bytes(),
+                ),
+                ("m.obj", QUAD.as_bytes().to_vec()),
+                ("g.gltf", gltf_quad("g.bin", 4, "")),
+                ("g.bin", bin.clone()),
+            ],
+            options: &[],
+            outcome: Image,
+        },
+    ];
+    let mut cases = vec![
         // OBJ
         quad_case("obj fine", QUAD, kd, &[], Image),
         quad_case(
@@ -644,7 +733,9 @@ fn corpus() -> Vec<Case> {
             Image,
         ),
         quad_case("cli path", QUAD, kd, &["--gi", "path", "--spp", "4"], Image),
-    ]
+    ];
+    cases.extend(gltf_cases);
+    cases
 }
 
 /// Every case of the bad-input corpus ends in a clear error naming its cause or in a

@@ -11,6 +11,7 @@ layout(set = SET_SCENE, binding = BINDING_MATERIALS, std430) readonly buffer Mat
 layout(set = SET_SCENE, binding = BINDING_ALBEDO_TEXTURE) uniform sampler2D albedo_texture;
 layout(set = SET_SCENE, binding = BINDING_COVERAGE_TEXTURE) uniform sampler2D coverage_texture;
 layout(set = SET_SCENE, binding = BINDING_NORMAL_TEXTURE) uniform sampler2D normal_texture;
+layout(set = SET_SCENE, binding = BINDING_EMISSION_TEXTURE) uniform sampler2D emission_texture;
 
 // How the material textures are sampled: implicitly over the fragment's footprint, or,
 // where a shader defines MATERIAL_GRADIENTS (compute shaders have no implicit
@@ -31,6 +32,15 @@ vec3 material_albedo(GpuMaterial m, vec2 uv) {
         albedo *= SAMPLE_MATERIAL(albedo_texture, uv).rgb;
     }
     return albedo;
+}
+
+// Ke x map_Ke: the radiance a surface emits along its winding normal.
+vec3 material_emission(GpuMaterial m, vec2 uv) {
+    vec3 emission = m.emission.rgb;
+    if (m.emission_texture != NO_TEXTURE) {
+        emission *= SAMPLE_MATERIAL(emission_texture, uv).rgb;
+    }
+    return emission;
 }
 
 // Cut-out mask: map_d (coverage textures hold it in every channel), 1 without one.

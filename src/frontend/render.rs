@@ -8,7 +8,6 @@ use ash::vk;
 
 use super::{check_validation, create_context, load_scene, Offscreen};
 use crate::cli::{RenderArgs, MAX_IMAGE_SIDE};
-use crate::gi::Progress;
 use crate::imageio::{box_downsample, box_downsample_srgb8};
 use crate::renderer::{OutputTarget, Renderer};
 use crate::vk::{copy_image_to_buffer, Buffer, ImageUse};
@@ -70,7 +69,18 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
         gpu_allocator::MemoryLocation::GpuToCpu,
     )?;
     let start = Instant::now();
-    let mut bar = Bar::new(renderer.gi().and_then(|t| t.progress()));
+    // The progress of a render that converges over frames.
+    let bar = renderer
+        .gi()
+        .and_then(|t| t.progress())
+        .filter(|p| p.frames_left > 1)
+        .map(|p| {
+            crate::progress::Progress::with_unit(
+                "path tracing",
+                "samples per pixel",
+                u64::from(p.total),
+            )
+        });
     for index in 0.. {
         let progress = renderer.gi().and_then(|t| t.progress());
         let last = progress.is_none_or(|p| p.frames_left <= 1);
@@ -113,10 +123,14 @@ pub fn run(args: &RenderArgs) -> Result<PathBuf> {
                 duration_text(estimate)
             );
         }
-        bar.update(renderer.gi().and_then(|t| t.progress()));
+        if let (Some(bar), Some(p)) = (&bar, renderer.gi().and_then(|t| t.progress())) {
+            bar.set(u64::from(p.done));
+        }
     }
     renderer.finish()?;
-    bar.finish();
+    if let Some(bar) = &bar {
+        bar.finish();
+    }
     log::info!(
         "rendered {}x{} ({}) in {:.1} ms (last frame's GPU: {})",
         size.0,
@@ -158,46 +172,5 @@ fn duration_text(seconds: f64) -> String {
         format!("{} min {} s", whole / 60, whole % 60)
     } else {
         format!("{seconds:.1} s")
-    }
-}
-
-/// The progress of a render that converges over frames: a bar on a terminal, else a log
-/// line at each quarter.
-struct Bar {
-    bar: Option<indicatif::ProgressBar>,
-    quarter: u32,
-}
-
-impl Bar {
-    fn new(progress: Option<Progress>) -> Self {
-        let bar = progress.filter(|p| p.frames_left > 1).map(|p| {
-            let bar = indicatif::ProgressBar::new(u64::from(p.total));
-            bar.set_style(
-                indicatif::ProgressStyle::with_template(
-                    "{bar:40} {pos}/{len} samples per pixel, {elapsed} so far, {eta} left",
-                )
-                .expect("a valid progress template"),
-            );
-            bar
-        });
-        Self { bar, quarter: 0 }
-    }
-
-    fn update(&mut self, progress: Option<Progress>) {
-        let (Some(bar), Some(p)) = (&self.bar, progress) else {
-            return;
-        };
-        bar.set_position(u64::from(p.done));
-        let quarter = 4 * p.done / p.total.max(1);
-        if bar.is_hidden() && quarter > self.quarter && quarter < 4 {
-            log::info!("{} of {} samples per pixel", p.done, p.total);
-        }
-        self.quarter = quarter;
-    }
-
-    fn finish(&self) {
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
-        }
     }
 }

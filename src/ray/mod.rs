@@ -437,7 +437,8 @@ impl SceneRays {
 }
 
 /// The emissive triangles of `bvh` (by their index in it), with their cumulative
-/// distribution by power (area x largest emitted radiance), and the total power.
+/// distribution by power (area x largest emitted radiance of the material's factor, which an
+/// emission texture scales by at most one), and the total power.
 fn emitters(scene: &Scene, bvh: &Bvh) -> (Vec<RayEmitter>, f32) {
     let mut list = Vec::new();
     let mut total = 0.0f64;

@@ -1,5 +1,5 @@
-//! Scene files: voxcone's TOML format and a bare `.obj` (the path-traced references'
-//! `*.scene.json`: `super::reference`), and what loading them shares.
+//! Scene files: voxcone's TOML format, a bare `.obj` and a bare glTF (the path-traced
+//! references' `*.scene.json`: `super::reference`), and what loading them shares.
 //!
 //! # TOML scene format
 //!
@@ -13,12 +13,12 @@
 //! up = [0.0, 1.0, 0.0]           # optional, default +Y; must not be parallel to the view
 //! fov_y_deg = 39.3               # full vertical field of view in (0, 180), default 45
 //!
-//! [[mesh]]                       # at least one; each OBJ keeps its own materials
-//! path = "cornell.obj"           # relative to the scene file, or absolute
+//! [[mesh]]                       # at least one; each file keeps its own materials
+//! path = "cornell.obj"           # .obj, .gltf or .glb, relative to the scene file or absolute
 //! translate = [0, 0, 0]          # optional
 //! rotate_deg = [0, 0, 0]         # optional, about X first, then Y, then Z
 //! scale = 1.0                    # optional, uniform, or per axis as [x, y, z]
-//! emission_scale = 1.0           # optional, multiplies MTL Ke (0 turns the emitters off)
+//! emission_scale = 1.0           # optional, multiplies Ke or glTF emission (0: emitters off)
 //! # optional animation, in object space before the transform above:
 //! animate = { kind = "spin", axis = [0, 1, 0], deg_per_s = 45.0 }
 //! # animate = { kind = "oscillate", axis = [1, 0, 0], amplitude = 0.5, period_s = 4.0 }
@@ -69,12 +69,17 @@
 //! directions need not be unit length but must be non-zero; intensities must be finite and
 //! non-negative.
 //!
-//! # Bare `.obj`
+//! A glTF mesh entry brings its geometry and materials only: a TOML scene's camera and
+//! lights are those of the TOML.
+//!
+//! # Bare `.obj` and glTF
 //!
 //! The camera looks at the centre of the bounds from the +Z side, a little above, far
 //! enough for the bounding sphere to fit a 45 degree field of view. One point light sits
 //! at 90 % of the height above the centre, with 0.5 * diagonal^2 W/sr per channel so that
-//! its irradiance at the scene's scale stays about the same whatever the units.
+//! its irradiance at the scene's scale stays about the same whatever the units. A bare
+//! glTF keeps its first camera and its lights, and gets the framing camera and the point
+//! light only where it has none (the light only when nothing emits either).
 
 use std::path::{Path, PathBuf};
 
@@ -82,7 +87,7 @@ use anyhow::{bail, ensure, Context as _, Result};
 use glam::{Mat4, Quat, Vec3};
 use serde::Deserialize;
 
-use super::obj::{Geometry, ObjEntry};
+use super::geometry::{FileSetup, Geometry, MeshEntry};
 use super::{Aabb, Animation, Camera, GiOverrides, Light, LightKind, LoadOptions, Orbit, Scene};
 
 #[derive(Deserialize, Debug)]
@@ -361,22 +366,26 @@ fn framing_camera(bounds: &Aabb) -> Camera {
     Camera::look_at(center + direction * distance, center, Vec3::Y, FOV_Y_DEG)
 }
 
-/// Loads the OBJs and textures; camera, lights and sky are left for the caller.
+/// Loads the mesh files and textures, with the cameras and lights the files bring (the
+/// first camera, every light); the scene's camera, lights and sky are left for the caller.
 pub(super) fn load_geometry(
-    entries: &[ObjEntry],
+    entries: &[MeshEntry],
     options: &LoadOptions,
     source: &Path,
-) -> Result<Scene> {
+) -> Result<(Scene, FileSetup)> {
     let mut geometry = Geometry::default();
+    let mut setup = FileSetup::default();
     for entry in entries {
-        geometry.add_obj(entry, options)?;
+        let file = geometry.add(entry, options)?;
+        setup.camera = setup.camera.or(file.camera);
+        setup.lights.extend(file.lights);
     }
     let triangle_count = geometry.meshes.iter().map(|m| m.indices.len() / 3).sum();
     if triangle_count == 0 {
         bail!("scene has no triangles: {}", source.display());
     }
     let (meshes, materials, textures) = geometry.finish()?;
-    Ok(Scene {
+    let scene = Scene {
         meshes,
         materials,
         textures,
@@ -387,7 +396,8 @@ pub(super) fn load_geometry(
         triangle_count,
         gi: GiOverrides::default(),
         image_size: None,
-    })
+    };
+    Ok((scene, setup))
 }
 
 pub(super) fn resolve(base: &Path, path: &Path) -> PathBuf {
@@ -455,7 +465,7 @@ fn scene_from_toml(
                 emission_scale.is_finite() && emission_scale >= 0.0,
                 "mesh[{i}].emission_scale must be finite and non-negative, got {emission_scale}"
             );
-            Ok(ObjEntry {
+            Ok(MeshEntry {
                 path,
                 transform: mesh_transform(i, spec)?,
                 emission_scale,
@@ -464,7 +474,14 @@ fn scene_from_toml(
         })
         .collect::<Result<Vec<_>>>()?;
 
-    let mut scene = load_geometry(&entries, options, source)?;
+    let (mut scene, setup) = load_geometry(&entries, options, source)?;
+    if setup.camera.is_some() || !setup.lights.is_empty() {
+        log::info!(
+            "the cameras and {} lights of the glTF meshes are not used: a TOML scene takes \
+             them from [camera] and [[light]]",
+            setup.lights.len()
+        );
+    }
     scene.camera = camera.unwrap_or_else(|| framing_camera(&scene.bounds(0.0)));
     scene.lights = lights;
     scene.sky = sky;
@@ -474,25 +491,42 @@ fn scene_from_toml(
 
 /// Loads a bare OBJ with a framing camera and one point light (see the module docs).
 pub fn load_bare_obj(path: &Path, options: &LoadOptions) -> Result<Scene> {
-    let entry = ObjEntry {
-        path,
-        transform: Mat4::IDENTITY,
-        emission_scale: 1.0,
-        animation: None,
-    };
-    let mut scene = load_geometry(&[entry], options, path)?;
+    let (mut scene, _) = load_geometry(&[MeshEntry::bare(path)], options, path)?;
     let bounds = scene.bounds(0.0);
+    scene.lights.push(default_light(&bounds));
+    scene.camera = framing_camera(&bounds);
+    Ok(scene)
+}
+
+/// Loads a glTF scene with its first camera and its lights; without a camera it is framed,
+/// and without lights or emissive materials it gets a bare OBJ's point light.
+pub fn load_bare_gltf(path: &Path, options: &LoadOptions) -> Result<Scene> {
+    let (mut scene, setup) = load_geometry(&[MeshEntry::bare(path)], options, path)?;
+    let bounds = scene.bounds(0.0);
+    scene.camera = setup.camera.unwrap_or_else(|| framing_camera(&bounds));
+    scene.lights = setup.lights;
+    let emissive = scene
+        .materials
+        .iter()
+        .any(|m| m.emission.max_element() > 0.0);
+    if scene.lights.is_empty() && !emissive {
+        log::info!("{} has no lights: adding a point light", path.display());
+        scene.lights.push(default_light(&bounds));
+    }
+    Ok(scene)
+}
+
+/// At 90 % of the height above the centre, with 0.5 * diagonal^2 W/sr (module docs).
+fn default_light(bounds: &Aabb) -> Light {
     let diagonal = bounds.diagonal();
     let mut position = bounds.center();
     position.y = bounds.min.y + 0.9 * bounds.size().y;
-    scene.lights.push(Light {
+    Light {
         kind: LightKind::Point,
         position,
         intensity: Vec3::splat(0.5 * diagonal * diagonal),
         orbit: None,
-    });
-    scene.camera = framing_camera(&bounds);
-    Ok(scene)
+    }
 }
 
 #[cfg(test)]

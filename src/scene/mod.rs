@@ -1,4 +1,5 @@
-//! Scenes: OBJ/MTL geometry and materials, textures with mips, camera, lights, animation.
+//! Scenes: OBJ/MTL and glTF geometry and materials, textures with mips, camera, lights,
+//! animation.
 //!
 //! Pure CPU code: everything the renderer uploads is decoded and laid out here, so the
 //! loaders can be tested without a GPU. The scene file formats are described in `file.rs`.
@@ -6,6 +7,8 @@
 mod animation;
 mod camera;
 mod file;
+mod geometry;
+mod gltf_file;
 mod light;
 mod obj;
 mod reference;
@@ -20,7 +23,7 @@ use glam::{Mat4, Vec3};
 pub use animation::{Animation, Orbit};
 pub use camera::Camera;
 pub use light::{Light, LightKind};
-pub use texture::{Texture, TextureKind};
+pub use texture::{AlphaCutout, Texture, TextureKind};
 
 /// One vertex, as uploaded to the GPU.
 ///
@@ -94,7 +97,7 @@ impl Aabb {
     }
 }
 
-/// Triangles of one material from one OBJ model.
+/// Triangles of one material from one OBJ model or glTF primitive.
 #[derive(Clone, Debug)]
 pub struct Mesh {
     pub name: String,
@@ -126,6 +129,8 @@ pub struct Material {
     /// Ke times the scene entry's emission_scale: radiance of a one-sided emitter along the
     /// winding normal.
     pub emission: Vec3,
+    /// Multiplies `emission` (map_Ke, glTF's emissive texture).
+    pub emission_texture: Option<u32>,
     /// d, or 1 - Tr (1 = opaque).
     pub dissolve: f32,
     /// map_d cut-out coverage.
@@ -147,6 +152,7 @@ impl Material {
             specular: Vec3::ZERO,
             roughness: 1.0,
             emission: Vec3::ZERO,
+            emission_texture: None,
             dissolve: 1.0,
             coverage_texture: None,
             normal_texture: None,
@@ -225,7 +231,8 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Loads a `.toml` scene file, a reference `.scene.json`, or a bare `.obj`.
+    /// Loads a `.toml` scene file, a reference `.scene.json`, a bare `.obj`, or a glTF
+    /// scene (`.gltf`, `.glb`).
     pub fn load(path: &Path, options: &LoadOptions) -> Result<Scene> {
         if !path.is_file() {
             bail!("scene file not found: {}", path.display());
@@ -238,9 +245,11 @@ impl Scene {
             reference::load_reference_json(path, options)?
         } else if name.ends_with(".obj") {
             file::load_bare_obj(path, options)?
+        } else if name.ends_with(".gltf") || name.ends_with(".glb") {
+            file::load_bare_gltf(path, options)?
         } else {
             bail!(
-                "{}: unknown scene type (expected .toml, .scene.json or .obj)",
+                "{}: unknown scene type (expected .toml, .scene.json, .obj, .gltf or .glb)",
                 path.display()
             );
         };

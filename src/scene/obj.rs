@@ -1,115 +1,107 @@
 //! OBJ + MTL loading through `tobj`.
 
 use std::cell::RefCell;
-use std::collections::HashMap;
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context as _, Result};
-use glam::{Mat4, Vec3};
-use rayon::prelude::*;
+use glam::Vec3;
 
-use super::{Aabb, Animation, LoadOptions, Material, Mesh, Texture, TextureKind, Vertex};
+use super::geometry::{
+    model_geometry, Geometry, MeshEntry, ModelAttributes, ModelGeometry, TextureRequests,
+};
+use super::{LoadOptions, Material, Mesh, TextureKind};
+use crate::progress::{Progress, ProgressReader};
 
-/// What a scene file says about one OBJ.
-pub struct ObjEntry<'a> {
-    pub path: &'a Path,
-    pub transform: Mat4,
-    pub emission_scale: f32,
-    pub animation: Option<Animation>,
-}
+/// Reads one OBJ with its MTLs into `geometry`.
+pub fn add(geometry: &mut Geometry, entry: &MeshEntry, options: &LoadOptions) -> Result<()> {
+    let path = entry.path;
+    let start = Instant::now();
+    let (models, obj_materials, material_dirs) = parse(path)?;
 
-/// The meshes and materials of a scene's OBJs. Textures are only collected while the OBJs
-/// are read, so that [`Geometry::finish`] can decode all of them in parallel.
-#[derive(Default)]
-pub struct Geometry {
-    pub meshes: Vec<Mesh>,
-    pub materials: Vec<Material>,
-    textures: TextureRequests,
-    /// Shared by every group without a material, in every OBJ of the scene.
-    default_material: Option<u32>,
-}
-
-impl Geometry {
-    /// Reads one OBJ with its MTLs; its materials are appended after those already loaded,
-    /// so that equal names in different OBJs stay different materials.
-    pub fn add_obj(&mut self, entry: &ObjEntry, options: &LoadOptions) -> Result<()> {
-        let path = entry.path;
-        let start = Instant::now();
-        let (models, obj_materials, material_dirs) = parse(path)?;
-
-        let first_material = self.materials.len() as u32;
-        for (m, dir) in obj_materials.iter().zip(&material_dirs) {
-            let material =
-                convert_material(m, dir, entry.emission_scale, options, &mut self.textures)
-                    .with_context(|| format!("in the materials of {}", path.display()))?;
-            self.materials.push(material);
-        }
-
-        let mut meshes = Vec::new();
-        for model in &models {
-            let Some(ModelGeometry {
-                vertices,
-                indices,
-                bounds,
-            }) = model_geometry(model).with_context(|| format!("in OBJ {}", path.display()))?
-            else {
-                continue;
-            };
-            let material = match model.mesh.material_id {
-                Some(id) if id < obj_materials.len() => first_material + id as u32,
-                _ => self.default_material(),
-            };
-            meshes.push(Mesh {
-                name: model.name.clone(),
-                vertices,
-                indices,
-                material,
-                transform: entry.transform,
-                animation: entry.animation,
-                local_bounds: bounds,
-                object_bounds: bounds,
-            });
-        }
-        let object_bounds = meshes
-            .iter()
-            .fold(Aabb::EMPTY, |b, m| b.union(&m.local_bounds));
-        for mesh in &mut meshes {
-            mesh.object_bounds = object_bounds;
-        }
-        let triangles: usize = meshes.iter().map(|m| m.indices.len() / 3).sum();
-        log::info!(
-            "loading {}: {triangles} triangles, {} materials ({:.2} s)",
-            path.file_name()
-                .unwrap_or(path.as_os_str())
-                .to_string_lossy(),
-            obj_materials.len(),
-            start.elapsed().as_secs_f64()
-        );
-        self.meshes.extend(meshes);
-        Ok(())
+    let first_material = geometry.materials.len() as u32;
+    for (m, dir) in obj_materials.iter().zip(&material_dirs) {
+        let material = convert_material(
+            m,
+            dir,
+            entry.emission_scale,
+            options,
+            &mut geometry.textures,
+        )
+        .with_context(|| format!("in the materials of {}", path.display()))?;
+        geometry.materials.push(material);
     }
 
-    fn default_material(&mut self) -> u32 {
-        *self.default_material.get_or_insert_with(|| {
-            self.materials.push(Material::default_grey());
-            self.materials.len() as u32 - 1
-        })
+    let mut meshes = Vec::new();
+    for model in &models {
+        let mesh = &model.mesh;
+        let positions: Vec<Vec3> = mesh
+            .positions
+            .chunks_exact(3)
+            .map(Vec3::from_slice)
+            .collect();
+        let normals: Vec<Vec3> = mesh.normals.chunks_exact(3).map(Vec3::from_slice).collect();
+        // OBJ puts v = 0 at the bottom of the image (see `Vertex`).
+        let uvs: Vec<[f32; 2]> = mesh
+            .texcoords
+            .chunks_exact(2)
+            .map(|t| [t[0], 1.0 - t[1]])
+            .collect();
+        let attributes = ModelAttributes {
+            name: &model.name,
+            positions: &positions,
+            normals: &normals,
+            uvs: &uvs,
+            indices: &mesh.indices,
+        };
+        let Some(ModelGeometry {
+            vertices,
+            indices,
+            bounds,
+        }) = model_geometry(&attributes).with_context(|| format!("in OBJ {}", path.display()))?
+        else {
+            continue;
+        };
+        let material = match mesh.material_id {
+            Some(id) if id < obj_materials.len() => first_material + id as u32,
+            _ => geometry.default_material(),
+        };
+        meshes.push(Mesh {
+            name: model.name.clone(),
+            vertices,
+            indices,
+            material,
+            transform: entry.transform,
+            animation: entry.animation,
+            local_bounds: bounds,
+            object_bounds: bounds,
+        });
     }
-
-    /// Decodes every requested texture (in parallel) and builds its mips.
-    pub fn finish(self) -> Result<(Vec<Mesh>, Vec<Material>, Vec<Texture>)> {
-        let textures = self.textures.decode()?;
-        Ok((self.meshes, self.materials, textures))
-    }
+    let triangles: usize = meshes.iter().map(|m| m.indices.len() / 3).sum();
+    log::info!(
+        "loading {}: {triangles} triangles, {} materials ({:.2} s)",
+        path.file_name()
+            .unwrap_or(path.as_os_str())
+            .to_string_lossy(),
+        obj_materials.len(),
+        start.elapsed().as_secs_f64()
+    );
+    geometry.push_entry_meshes(meshes);
+    Ok(())
 }
 
 /// Parses an OBJ and its MTLs: models, materials, and the folder of the MTL each material
 /// came from (its texture paths are relative to that).
 fn parse(path: &Path) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>, Vec<PathBuf>)> {
     let file = File::open(path).with_context(|| format!("cannot open OBJ {}", path.display()))?;
+    let size = file.metadata().map_or(0, |m| m.len());
+    let name = path
+        .file_name()
+        .unwrap_or(path.as_os_str())
+        .to_string_lossy();
+    let progress = Progress::bytes(&format!("parsing {name}"), size);
     let dir = path.parent().unwrap_or(Path::new(""));
     // tobj keeps going after a failed mtllib and only reports an error when no MTL loaded at
     // all, so every failure is recorded here to name the file.
@@ -117,31 +109,32 @@ fn parse(path: &Path) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>, Vec<Path
     let material_dirs = RefCell::new(Vec::new());
     // GPU_LOAD_OPTIONS: triangulated, one index for position, normal and uv, and points and
     // lines dropped (they are not surfaces).
-    let (models, materials) =
-        tobj::load_obj_buf(&mut BufReader::new(file), &tobj::GPU_LOAD_OPTIONS, |mtl| {
-            let mtl_path = dir.join(mtl);
-            let text = match read_mtl(&mtl_path) {
-                Ok(text) => text,
-                Err(e) => {
-                    failures.borrow_mut().push((mtl_path, format!("{e:#}")));
-                    return Err(tobj::LoadError::MaterialParseError);
-                }
-            };
-            let result = tobj::load_mtl_buf(&mut text.as_bytes());
-            match &result {
-                Ok((materials, _)) => {
-                    let mtl_dir = mtl_path.parent().unwrap_or(Path::new("")).to_path_buf();
-                    material_dirs
-                        .borrow_mut()
-                        .extend(std::iter::repeat_n(mtl_dir, materials.len()));
-                }
-                Err(e) => failures
-                    .borrow_mut()
-                    .push((mtl_path, format!("cannot parse: {e}"))),
+    let mut reader = ProgressReader::new(BufReader::new(file), &progress);
+    let (models, materials) = tobj::load_obj_buf(&mut reader, &tobj::GPU_LOAD_OPTIONS, |mtl| {
+        let mtl_path = dir.join(mtl);
+        let text = match read_mtl(&mtl_path) {
+            Ok(text) => text,
+            Err(e) => {
+                failures.borrow_mut().push((mtl_path, format!("{e:#}")));
+                return Err(tobj::LoadError::MaterialParseError);
             }
-            result
-        })
-        .map_err(|e| anyhow!("cannot parse OBJ {}: {e}", path.display()))?;
+        };
+        let result = tobj::load_mtl_buf(&mut text.as_bytes());
+        match &result {
+            Ok((materials, _)) => {
+                let mtl_dir = mtl_path.parent().unwrap_or(Path::new("")).to_path_buf();
+                material_dirs
+                    .borrow_mut()
+                    .extend(std::iter::repeat_n(mtl_dir, materials.len()));
+            }
+            Err(e) => failures
+                .borrow_mut()
+                .push((mtl_path, format!("cannot parse: {e}"))),
+        }
+        result
+    })
+    .map_err(|e| anyhow!("cannot parse OBJ {}: {e}", path.display()))?;
+    progress.finish();
     if let Some((mtl, e)) = failures.into_inner().first() {
         bail!("MTL {} (mtllib of {}): {e}", mtl.display(), path.display());
     }
@@ -212,7 +205,7 @@ fn convert_material(
 ) -> Result<Material> {
     let name = &m.name;
     let mut texture =
-        |statement: &str, kind| textures.request(texture_path(dir, statement), kind, name);
+        |statement: &str, kind| textures.request_file(texture_path(dir, statement), kind, name);
     let albedo_texture = m
         .diffuse_texture
         .as_deref()
@@ -222,6 +215,11 @@ fn convert_material(
         .dissolve_texture
         .as_deref()
         .map(|t| texture(t, TextureKind::Coverage))
+        .transpose()?;
+    let emission_texture = m
+        .unknown_param
+        .get("map_Ke")
+        .map(|t| texture(t, TextureKind::Albedo))
         .transpose()?;
     let normal_map = m.unknown_param.get("norm").map(String::as_str).or_else(|| {
         m.normal_texture
@@ -256,6 +254,7 @@ fn convert_material(
         },
         roughness: (2.0 / (shininess + 2.0)).sqrt().clamp(0.02, 1.0),
         emission: vec3(m.emissive) * emission_scale,
+        emission_texture,
         dissolve: dissolve.clamp(0.0, 1.0),
         coverage_texture,
         normal_texture,
@@ -292,151 +291,6 @@ fn looks_like_normal_map(statement: &str) -> bool {
         .unwrap_or(statement)
         .to_ascii_lowercase();
     name.contains("normal") || name.contains("_nrm") || name.contains("_norm")
-}
-
-struct ModelGeometry {
-    vertices: Vec<Vertex>,
-    indices: Vec<u32>,
-    bounds: Aabb,
-}
-
-/// The triangles of one OBJ model, or `None` for a model without any of non-zero area.
-fn model_geometry(model: &tobj::Model) -> Result<Option<ModelGeometry>> {
-    let mesh = &model.mesh;
-    let count = mesh.positions.len() / 3;
-    if mesh.positions.iter().any(|p| !p.is_finite()) {
-        bail!(
-            "model {:?} has a vertex position that is not a finite number",
-            model.name
-        );
-    }
-    if mesh.indices.iter().any(|&i| i as usize >= count) {
-        bail!(
-            "model {:?} indexes a vertex that does not exist",
-            model.name
-        );
-    }
-    let position = |i: u32| Vec3::from_slice(&mesh.positions[3 * i as usize..][..3]);
-    let has_uvs = mesh.texcoords.len() == 2 * count;
-    let uv = |i: u32| {
-        if has_uvs {
-            [
-                mesh.texcoords[2 * i as usize],
-                1.0 - mesh.texcoords[2 * i as usize + 1],
-            ]
-        } else {
-            [0.0, 0.0]
-        }
-    };
-    let file_normal = |i: u32| Vec3::from_slice(&mesh.normals[3 * i as usize..][..3]);
-    let has_normals = mesh.normals.len() == 3 * count
-        && (0..count as u32).all(|i| file_normal(i).length_squared() > 1e-24);
-    // Zero-area triangles are dropped, as the references do: they cover no pixel and
-    // have no normal.
-    let triangles: Vec<([u32; 3], Vec3)> = mesh
-        .indices
-        .chunks_exact(3)
-        .filter_map(|t| {
-            let t = [t[0], t[1], t[2]];
-            let [p0, p1, p2] = t.map(position);
-            let n = (p1 - p0).cross(p2 - p0);
-            (n != Vec3::ZERO).then(|| (t, n.normalize_or(Vec3::Z)))
-        })
-        .collect();
-    if triangles.is_empty() {
-        return Ok(None);
-    }
-
-    let (vertices, indices): (Vec<Vertex>, Vec<u32>) = if has_normals {
-        let vertices = (0..count as u32)
-            .map(|i| Vertex {
-                position: position(i).to_array(),
-                normal: file_normal(i).normalize().to_array(),
-                uv: uv(i),
-            })
-            .collect();
-        (vertices, triangles.iter().flat_map(|(t, _)| *t).collect())
-    } else {
-        // Flat normals from the winding (counter-clockwise = front), as the references use
-        // for OBJs without normals; each corner gets its own vertex.
-        let vertices: Vec<Vertex> = triangles
-            .iter()
-            .flat_map(|&(t, n)| {
-                t.map(|i| Vertex {
-                    position: position(i).to_array(),
-                    normal: n.to_array(),
-                    uv: uv(i),
-                })
-            })
-            .collect();
-        let indices = (0..vertices.len() as u32).collect();
-        (vertices, indices)
-    };
-    let bounds = indices.iter().fold(Aabb::EMPTY, |mut b, &i| {
-        b.extend(Vec3::from(vertices[i as usize].position));
-        b
-    });
-    Ok(Some(ModelGeometry {
-        vertices,
-        indices,
-        bounds,
-    }))
-}
-
-/// Textures requested by materials, each (file, kind) once.
-#[derive(Default)]
-struct TextureRequests {
-    index: HashMap<(PathBuf, TextureKind), u32>,
-    /// File, kind, and the first material that asked (to name it in errors).
-    list: Vec<(PathBuf, TextureKind, String)>,
-}
-
-impl TextureRequests {
-    fn request(&mut self, path: PathBuf, kind: TextureKind, material: &str) -> Result<u32> {
-        if path.is_dir() {
-            bail!(
-                "texture {} of material {material:?} is a directory, not an image",
-                path.display()
-            );
-        }
-        if !path.is_file() {
-            bail!(
-                "texture {} of material {material:?} not found",
-                path.display()
-            );
-        }
-        let key = (path.canonicalize().unwrap_or(path), kind);
-        if let Some(&index) = self.index.get(&key) {
-            return Ok(index);
-        }
-        let index = self.list.len() as u32;
-        self.list.push((key.0.clone(), kind, material.to_string()));
-        self.index.insert(key, index);
-        Ok(index)
-    }
-
-    fn decode(self) -> Result<Vec<Texture>> {
-        if self.list.is_empty() {
-            return Ok(Vec::new());
-        }
-        let start = Instant::now();
-        let textures = self
-            .list
-            .par_iter()
-            .map(|(path, kind, material)| {
-                Texture::load(path, *kind)
-                    .with_context(|| format!("texture of material {material:?}"))
-            })
-            .collect::<Result<Vec<_>>>()?;
-        let bytes: usize = textures.iter().map(Texture::bytes).sum();
-        log::info!(
-            "decoded {} textures ({:.0} MiB with mips) in {:.2} s",
-            textures.len(),
-            bytes as f64 / (1024.0 * 1024.0),
-            start.elapsed().as_secs_f64()
-        );
-        Ok(textures)
-    }
 }
 
 #[cfg(test)]

@@ -15,7 +15,7 @@ use glam::{Mat4, Vec3};
 use serde::Deserialize;
 
 use super::file::{camera_from, direction, finite, folder, load_geometry, non_negative, resolve};
-use super::obj::ObjEntry;
+use super::geometry::MeshEntry;
 use super::{Light, LightKind, LoadOptions, Scene};
 
 #[derive(Deserialize)]
@@ -133,7 +133,7 @@ fn scene_from_reference(
 
     let root = resolve(base, spec.scenes_root.as_deref().unwrap_or(Path::new("")));
     let obj_path = resolve(&root, &spec.obj);
-    let entry = ObjEntry {
+    let entry = MeshEntry {
         path: &obj_path,
         transform: Mat4::IDENTITY,
         emission_scale,
@@ -156,7 +156,7 @@ fn scene_from_reference(
             Some((w as u32, h as u32))
         }
     };
-    let mut scene = load_geometry(&[entry], options, source)?;
+    let (mut scene, _) = load_geometry(&[entry], options, source)?;
     scene.image_size = image_size;
     scene.camera = camera;
     scene.lights = lights;

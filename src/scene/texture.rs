@@ -13,7 +13,7 @@ use crate::imageio::{srgba8_decode, srgba8_encode, unorm8};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TextureKind {
-    /// sRGB colour (map_Kd); alpha is linear.
+    /// sRGB colour (map_Kd; glTF's base colour and emissive textures); alpha is linear.
     Albedo,
     /// Cut-out coverage (map_d), linear, in all four channels: the alpha channel when the
     /// image has one that is not entirely opaque, else the luminance (Rec. 601 luma, as
@@ -34,29 +34,80 @@ pub struct Texture {
     pub mips: Vec<Vec<u8>>,
 }
 
+/// How a glTF alpha (`MASK`, and the texture of `BLEND`) becomes a cut-out coverage
+/// texture: alpha x `factor`, mapped piecewise linearly so that `cutoff` lands on the
+/// shaders' fixed threshold of one half (0 stays 0, 1 stays 1). The order of the values,
+/// and so which texels pass, is kept, and the mips still average coverage.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlphaCutout {
+    pub factor: f32,
+    pub cutoff: f32,
+}
+
+impl AlphaCutout {
+    fn coverage(&self, alpha: f32) -> f32 {
+        let a = (alpha * self.factor).clamp(0.0, 1.0);
+        if a < self.cutoff {
+            0.5 * a / self.cutoff
+        } else if self.cutoff < 1.0 {
+            0.5 + 0.5 * (a - self.cutoff) / (1.0 - self.cutoff)
+        } else {
+            0.5
+        }
+    }
+}
+
 impl Texture {
-    pub fn load(path: &Path, kind: TextureKind) -> Result<Texture> {
+    /// Decodes image file `path` as `kind` (with `cutout`, the coverage of its alpha).
+    pub fn load(path: &Path, kind: TextureKind, cutout: Option<AlphaCutout>) -> Result<Texture> {
         let image = image::ImageReader::open(path)
             .and_then(|r| r.with_guessed_format())
             .with_context(|| format!("cannot read texture {}", path.display()))?
             .decode()
             .with_context(|| format!("cannot decode texture {}", path.display()))?;
+        Self::checked(path, kind, cutout, &image)
+    }
+
+    /// Decodes the encoded image `bytes` (named `name` in messages).
+    pub fn decode(
+        name: &Path,
+        bytes: &[u8],
+        kind: TextureKind,
+        cutout: Option<AlphaCutout>,
+    ) -> Result<Texture> {
+        let image = image::load_from_memory(bytes)
+            .with_context(|| format!("cannot decode texture {}", name.display()))?;
+        Self::checked(name, kind, cutout, &image)
+    }
+
+    fn checked(
+        path: &Path,
+        kind: TextureKind,
+        cutout: Option<AlphaCutout>,
+        image: &DynamicImage,
+    ) -> Result<Texture> {
         ensure!(
             image.width() > 0 && image.height() > 0,
             "texture {} is empty",
             path.display()
         );
-        Ok(Texture::from_image(path.to_path_buf(), kind, &image))
+        Ok(Texture::from_image(path.to_path_buf(), kind, cutout, image))
     }
 
     /// Converts a decoded, non-empty image for `kind` and builds its mips.
-    fn from_image(path: PathBuf, kind: TextureKind, image: &DynamicImage) -> Texture {
+    fn from_image(
+        path: PathBuf,
+        kind: TextureKind,
+        cutout: Option<AlphaCutout>,
+        image: &DynamicImage,
+    ) -> Texture {
         let (width, height) = (image.width(), image.height());
-        let level0 = match kind {
+        let level0 = match (kind, cutout) {
+            (TextureKind::Coverage, Some(cutout)) => alpha_coverage(image, cutout),
             // Float images hold linear values; bytes of an albedo texture must be sRGB.
-            TextureKind::Albedo if is_float(image) => rgba32f_to_srgb8(image),
-            TextureKind::Albedo | TextureKind::Normal => image.to_rgba8().into_raw(),
-            TextureKind::Coverage => coverage(image),
+            (TextureKind::Albedo, _) if is_float(image) => rgba32f_to_srgb8(image),
+            (TextureKind::Albedo | TextureKind::Normal, _) => image.to_rgba8().into_raw(),
+            (TextureKind::Coverage, None) => coverage(image),
         };
         Texture {
             path,
@@ -85,6 +136,15 @@ fn rgba32f_to_srgb8(image: &DynamicImage) -> Vec<u8> {
         .to_rgba32f()
         .pixels()
         .flat_map(|p| srgba8_encode(p.0))
+        .collect()
+}
+
+/// The alpha channel (1 without one) through `cutout`, in every channel.
+fn alpha_coverage(image: &DynamicImage, cutout: AlphaCutout) -> Vec<u8> {
+    image
+        .to_rgba8()
+        .pixels()
+        .flat_map(|p| [unorm8(cutout.coverage(f32::from(p[3]) / 255.0)); 4])
         .collect()
 }
 
@@ -188,6 +248,7 @@ mod tests {
         Texture::from_image(
             PathBuf::from("test.png"),
             kind,
+            None,
             &DynamicImage::ImageRgba8(image),
         )
     }
@@ -237,8 +298,43 @@ mod tests {
         let t = texture(TextureKind::Coverage, mask);
         assert_eq!(t.mips[0], [0, 0, 0, 0, 150, 150, 150, 150]);
         let grey = DynamicImage::ImageLuma8(image::GrayImage::from_pixel(1, 1, image::Luma([77])));
-        let t = Texture::from_image(PathBuf::new(), TextureKind::Coverage, &grey);
+        let t = Texture::from_image(PathBuf::new(), TextureKind::Coverage, None, &grey);
         assert_eq!(t.mips[0], [77; 4]);
+    }
+
+    #[test]
+    fn alpha_cutout_puts_the_cutoff_on_one_half() {
+        let cutout = AlphaCutout {
+            factor: 1.0,
+            cutoff: 0.25,
+        };
+        // Alpha bytes around the cutoff (0.25 = byte 63.75): those at or above it must
+        // reach the shaders' threshold 0.5, those below must not.
+        let alphas = [0u8, 63, 64, 128, 255];
+        let image = RgbaImage::from_fn(5, 1, |x, _| Rgba([9, 9, 9, alphas[x as usize]]));
+        let t = Texture::from_image(
+            PathBuf::new(),
+            TextureKind::Coverage,
+            Some(cutout),
+            &DynamicImage::ImageRgba8(image),
+        );
+        let kept: Vec<bool> = t.mips[0]
+            .chunks(4)
+            .map(|p| p[0] as f32 / 255.0 >= 0.5)
+            .collect();
+        assert_eq!(kept, [false, false, true, true, true]);
+        assert_eq!((t.mips[0][0], t.mips[0][16]), (0, 255), "0 and 1 stay");
+        // The factor scales alpha first: 0.5 x 255 falls below a cutoff of 0.6.
+        let half = AlphaCutout {
+            factor: 0.5,
+            cutoff: 0.6,
+        };
+        assert!(half.coverage(1.0) < 0.5 && half.coverage(0.0) == 0.0);
+        let all = AlphaCutout {
+            factor: 1.0,
+            cutoff: 0.0,
+        };
+        assert!(all.coverage(0.0) >= 0.5, "cutoff 0 keeps everything");
     }
 
     #[test]
@@ -268,7 +364,7 @@ mod tests {
             1,
             image::Rgb([0.5, 0.0, 1.0]),
         ));
-        let t = Texture::from_image(PathBuf::new(), TextureKind::Albedo, &image);
+        let t = Texture::from_image(PathBuf::new(), TextureKind::Albedo, None, &image);
         assert_eq!(t.mips[0], [188, 0, 255, 255]);
     }
 
@@ -279,13 +375,13 @@ mod tests {
         RgbaImage::from_pixel(3, 2, Rgba([1, 2, 3, 4]))
             .save(&path)
             .unwrap();
-        let t = Texture::load(&path, TextureKind::Albedo).unwrap();
+        let t = Texture::load(&path, TextureKind::Albedo, None).unwrap();
         assert_eq!((t.width, t.height, t.mips.len()), (3, 2, 2));
         assert_eq!(t.bytes(), 3 * 2 * 4 + 4);
         let junk = dir.write("junk.png", "not an image");
         let message = format!(
             "{:#}",
-            Texture::load(&junk, TextureKind::Albedo).unwrap_err()
+            Texture::load(&junk, TextureKind::Albedo, None).unwrap_err()
         );
         assert!(message.contains("junk.png"), "{message}");
     }

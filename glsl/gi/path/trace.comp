@@ -106,6 +106,9 @@ Surface surface_at(Hit hit, vec3 dir) {
     s.transmit = material_refracts(m) ? 1.0 - m.albedo.a : 0.0;
     s.eta = front ? m.emission.a : 1.0 / m.emission.a;
     s.emitted = front ? m.emission.rgb : vec3(0.0);
+    if (front && m.emission_texture != NO_TEXTURE) {
+        s.emitted *= texture_bilinear(m.emission_texture, uv, true).rgb;
+    }
     return s;
 }
 
@@ -238,7 +241,8 @@ vec3 emitter_light(Surface s, vec3 origin, inout uint rng) {
             hi = mid;
         }
     }
-    RayTriangle tri = ray_triangle(ray_emitter(lo).triangle);
+    uint emitter = ray_emitter(lo).triangle;
+    RayTriangle tri = ray_triangle(emitter);
     float su = sqrt(random_next(rng));
     float r = random_next(rng);
     vec3 q = tri.v0.xyz + su * (1.0 - r) * tri.e1.xyz + su * r * tri.e2.xyz;
@@ -251,8 +255,14 @@ vec3 emitter_light(Surface s, vec3 origin, inout uint rng) {
     if (cos_light <= 0.0 || cos_s <= 0.0 || dot(s.ng, l) <= 0.0 || !visible(origin, l, dist * (1.0 - 1e-4), rng)) {
         return vec3(0.0);
     }
-    vec3 radiance = ray_material(floatBitsToUint(tri.v0.w)).emission.rgb;
+    // Emitters are picked by their factor's power (src/ray/mod.rs), which the density
+    // follows; the texture only scales what the sample carries.
+    GpuMaterial em = ray_material(floatBitsToUint(tri.v0.w));
+    vec3 radiance = em.emission.rgb;
     float light_pdf = emitter_pdf(max(radiance.r, max(radiance.g, radiance.b)), dist, cos_light);
+    if (em.emission_texture != NO_TEXTURE) {
+        radiance *= texture_bilinear(em.emission_texture, triangle_uv(emitter, vec2(su * (1.0 - r), su * r)), true).rgb;
+    }
     float weight = mis_weight(light_pdf, bsdf_pdf(s, l));
     return brdf(s, l) * radiance * cos_s * weight / light_pdf;
 }
@@ -319,7 +329,8 @@ bool extend(inout Path p) {
         RayTriangle tri = ray_triangle(hit.triangle);
         bool sampled = (floatBitsToUint(tri.e2.w) & RAY_MOVING) == 0u && rays.emitter_count > 0u;
         if (p.bsdf_pdf > 0.0 && sampled) {
-            float largest = max(s.emitted.r, max(s.emitted.g, s.emitted.b));
+            vec3 factor = ray_material(floatBitsToUint(tri.v0.w)).emission.rgb;
+            float largest = max(factor.r, max(factor.g, factor.b));
             weight = mis_weight(p.bsdf_pdf, emitter_pdf(largest, hit.t, dot(s.ng, -p.dir)));
         }
         p.radiance += p.throughput * s.emitted * weight;

@@ -71,6 +71,6 @@ void main() {
     float specular = (frame.flags & FLAG_SPECULAR) != 0u ? dot(m.specular.rgb, vec3(1.0 / 3.0)) : 0.0;
     out_albedo = vec4(material_albedo(m, in_uv), specular);
     out_normal = vec4(n, m.specular.a);
-    out_emission = vec4(front ? m.emission.rgb : vec3(0.0), 0.0);
+    out_emission = vec4(front ? material_emission(m, in_uv) : vec3(0.0), 0.0);
     out_transmission = vec2(transmission ? 1.0 - m.albedo.a : 0.0, m.emission.a);
 }

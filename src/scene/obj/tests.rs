@@ -1,17 +1,12 @@
 use std::time::Instant;
 
 use super::super::testing::{error_text, shared_dir, write_quad, TempDir};
+use super::super::{Aabb, Texture, Vertex};
 use super::*;
 
 fn load(path: &Path, options: &LoadOptions) -> Result<(Vec<Mesh>, Vec<Material>, Vec<Texture>)> {
     let mut geometry = Geometry::default();
-    let entry = ObjEntry {
-        path,
-        transform: Mat4::IDENTITY,
-        emission_scale: 1.0,
-        animation: None,
-    };
-    geometry.add_obj(&entry, options)?;
+    geometry.add(&MeshEntry::bare(path), options)?;
     geometry.finish()
 }
 

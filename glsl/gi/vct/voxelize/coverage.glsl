@@ -26,7 +26,7 @@ void cover_pixel(vec2 pixel, vec3 normal, vec2 uv, vec4 bounds, uint axis, vec3 
     }
     vec3 albedo = material_albedo(m, uv);
     vec3 n = normalize(normal);
-    vec3 emission = clamp(m.emission.rgb / max(vct.emission_range, 1e-6), 0.0, 1.0);
+    vec3 emission = clamp(material_emission(m, uv) / max(vct.emission_range, 1e-6), 0.0, 1.0);
 
     // The triangle's depth over this pixel's footprint: a slope up to 1 (dominant axis)
     // spans up to two voxels, and every one of them is covered.

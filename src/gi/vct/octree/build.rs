@@ -14,6 +14,7 @@ use super::nodes::Over;
 use super::pools::{self, overflowed, Capacities, Fragments, Pools};
 use super::{Octree, BRICK_USE, COUNTERS_BYTES, RADIANCE_USE};
 use crate::gpu_layout::{self as layout, OctreeBounceDispatch, OctreeCounters, OctreeLevel};
+use crate::progress::Progress;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
     compute_to_compute, copies_to_host_barrier, image_barrier, stage_barrier, update_buffer,
@@ -98,7 +99,10 @@ impl Octree {
             &[Phase::Fragments, Phase::Octree]
         };
         let mut next = 0;
+        // Phases done of those to run; a regrowth sets it back to the phase run again.
+        let progress = Progress::new("building the octree", phases.len() as u64);
         while let Some(&phase) = phases.get(next) {
+            progress.set(next as u64);
             let (counters, levels, timings) = self.run(phase, draw, set, listed)?;
             if counters.overflow == 0 {
                 if phase == Phase::Octree {
@@ -159,6 +163,7 @@ impl Octree {
                 next = 1;
             }
         }
+        progress.finish();
         let (counters, levels) = built.context("the octree phase did not run")?;
         // A frame's new bricks hold at most what the pools hold beyond the static part
         // (more overflows, and the pools grow).
