@@ -569,6 +569,11 @@ fn corpus() -> Vec<Case> {
         texture_case("mtl texture", png(64, 32), Image),
         // Beyond the device's largest image (lavapipe: 16384): a smaller mip level.
         texture_case("mtl huge texture", png(20000, 1), Image),
+        // The same for the path tracer's texture atlas.
+        Case {
+            options: &["--gi", "path", "--spp", "4"],
+            ..texture_case("mtl huge texture, path traced", png(20000, 1), Image)
+        },
         quad_case(
             "mtl texture is a directory",
             QUAD,
