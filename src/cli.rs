@@ -167,6 +167,9 @@ pub struct ViewArgs {
     /// `--frames` (smoke tests of swapchain recreation).
     #[arg(long, value_parser = parse_size, requires = "frames")]
     pub resize_to: Option<(u32, u32)>,
+    /// Start without the settings panel (F1 shows it).
+    #[arg(long)]
+    pub no_ui: bool,
 }
 
 /// The most frames `bench` times or warms up with: together they count in a u32.
@@ -196,6 +199,9 @@ pub struct BenchArgs {
     /// orbiting lights move as in the viewer) instead of rendering every frame at `--time`.
     #[arg(long)]
     pub animate: bool,
+    /// Draw the viewer's settings panel over every frame, as the timed pass `ui`.
+    #[arg(long)]
+    pub ui: bool,
 }
 
 #[derive(Args, Debug)]

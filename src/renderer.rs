@@ -24,7 +24,7 @@ use crate::scene_gpu::{GpuScene, SceneDraw};
 use crate::settings::{RenderSettings, Tonemap};
 use crate::vk::{
     compute_to_compute, copy_image_to_buffer, image_barrier, sampler_info, Buffer, Context,
-    DescriptorSets, Frame, FrameRing, Image, ImageUse, Sampler,
+    DescriptorSets, Frame, FrameRing, Image, ImageUse, Sampler, COLOR_TARGET_RANGE,
 };
 
 /// Where a frame's composite goes.
@@ -74,7 +74,7 @@ pub struct Renderer {
     ctx: Arc<Context>,
 }
 
-const FRAMES_IN_FLIGHT: usize = 2;
+pub const FRAMES_IN_FLIGHT: usize = 2;
 
 impl Renderer {
     pub fn new(
@@ -479,13 +479,7 @@ impl Renderer {
             ImageUse::FRAGMENT_READ,
         );
         self.radiance_last_use = ImageUse::FRAGMENT_READ;
-        let range = vk::ImageSubresourceRange {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            base_mip_level: 0,
-            level_count: 1,
-            base_array_layer: 0,
-            layer_count: 1,
-        };
+        let range = COLOR_TARGET_RANGE;
         image_barrier(
             &ctx,
             cmd,
@@ -506,6 +500,50 @@ impl Renderer {
         );
         timer.end(cmd);
         Ok(())
+    }
+
+    /// Draws an overlay (the viewer's panel) over the composite of [`Self::record_frame`],
+    /// whose `output.after` must be [`ImageUse::COLOR_ATTACHMENT`], as the timed pass
+    /// `name`, then leaves the image in `after`. `draw` records into a dynamic rendering
+    /// that keeps the composite (load op LOAD).
+    pub fn record_overlay(
+        &mut self,
+        frame: &Frame,
+        output: &OutputTarget,
+        name: &str,
+        after: ImageUse,
+        draw: impl FnOnce(vk::CommandBuffer) -> Result<()>,
+    ) -> Result<()> {
+        debug_assert_eq!(output.after.layout, ImageUse::COLOR_ATTACHMENT.layout);
+        let (ctx, cmd) = (&self.ctx, frame.cmd);
+        let timer = &mut self.frames[frame.slot].timer;
+        timer.begin(cmd, name);
+        let color = [vk::RenderingAttachmentInfo::default()
+            .image_view(output.view)
+            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::LOAD)
+            .store_op(vk::AttachmentStoreOp::STORE)];
+        let rendering = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent: output.extent,
+            })
+            .layer_count(1)
+            .color_attachments(&color);
+        unsafe { ctx.device.cmd_begin_rendering(cmd, &rendering) };
+        let drawn = draw(cmd);
+        unsafe { ctx.device.cmd_end_rendering(cmd) };
+        let range = COLOR_TARGET_RANGE;
+        image_barrier(
+            ctx,
+            cmd,
+            output.image,
+            range,
+            ImageUse::COLOR_ATTACHMENT,
+            after,
+        );
+        timer.end(cmd);
+        drawn
     }
 
     /// Copies the frame's HDR radiance (RGBA32F) into `buffer`, which must hold

@@ -117,13 +117,22 @@ const STORM: &str = r#"
 voxcone=$1; shift
 "$voxcone" view --size 256x256 &
 pid=$!
+"#;
+
+/// The end of a script's first part: `$wid` is the window of the viewer `$pid`, else the
+/// script fails.
+const WAIT_FOR_WINDOW: &str = r#"
 wid=""
 for i in $(seq 300); do
     wid=$(xdotool search --pid $pid 2>/dev/null | head -1)
     [ -n "$wid" ] && break
     sleep 0.1
 done
-[ -n "$wid" ] || { echo "storm: the viewer opened no window" >&2; kill $pid; exit 2; }
+[ -n "$wid" ] || { echo "the viewer opened no window" >&2; kill $pid; exit 2; }
+"#;
+
+/// The storm itself, after [`WAIT_FOR_WINDOW`].
+const STORM_RESIZES: &str = r#"
 sleep 1
 for size in "$@"; do
     xdotool windowsize $wid ${size%x*} ${size#*x}
@@ -143,7 +152,7 @@ fn resize_storms_keep_validation_clean() {
     require("xdotool", "xdotool");
     let dir = temp_dir("storm");
     let script = dir.join("storm.sh");
-    std::fs::write(&script, STORM).unwrap();
+    std::fs::write(&script, [STORM, WAIT_FOR_WINDOW, STORM_RESIZES].concat()).unwrap();
     // A small deterministic generator (xorshift): the same storms every run.
     let mut state = 0x2545_f491_u32;
     let mut next = |n: u32| {
@@ -185,4 +194,107 @@ fn resize_storms_keep_validation_clean() {
             "storm {storm}: only {recreations} recreations"
         );
     }
+}
+
+/// Opens the viewer at 800x500, resizes its window to 640x400, clicks the panel's "off"
+/// technique (at (20, 53): the panel's layout is fixed, egui bringing its own fonts), and
+/// lets it save its last frame after `--frames`.
+const PANEL_CLICK: &str = r#"
+voxcone=$1; shot=$2
+"$voxcone" view --size 800x500 --frames 120 --screenshot "$shot" &
+pid=$!
+"#;
+
+/// The click, after [`WAIT_FOR_WINDOW`].
+const PANEL_CLICK_ACTIONS: &str = r#"
+sleep 3
+xdotool windowsize --sync $wid 640 400
+sleep 1
+xdotool mousemove --window $wid 20 53 click 1
+wait $pid
+"#;
+
+/// Mean absolute difference of two images' RGB over columns `x0..x1` (same size).
+fn difference(
+    a: &voxcone::imageio::RgbImage,
+    b: &voxcone::imageio::RgbImage,
+    x0: u32,
+    x1: u32,
+) -> f32 {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let mut sum = 0.0f64;
+    let mut count = 0usize;
+    for y in 0..a.height {
+        for x in x0..x1 {
+            let i = 3 * (y * a.width + x) as usize;
+            for c in 0..3 {
+                sum += f64::from((a.data[i + c] - b.data[i + c]).abs());
+                count += 1;
+            }
+        }
+    }
+    (sum / count as f64) as f32
+}
+
+/// The settings panel (egui) under Xvfb with validation on: it is drawn over the image
+/// (against `--no-ui`), a click on its "off" technique rebuilds the renderer without GI
+/// (the image then matches a `--gi off` viewer's, and not the dense one's), the window
+/// resizes with the panel on it, and the viewer exits cleanly.
+#[test]
+fn settings_panel_draws_switches_the_technique_and_resizes() {
+    require("xdotool", "xdotool");
+    let dir = temp_dir("panel");
+    let shot = |name: &str, extra: &[&str]| {
+        let path = dir.join(name);
+        let mut args: Vec<&OsStr> = ["--frames", "12", "--size", "640x400", "--screenshot"]
+            .iter()
+            .map(OsStr::new)
+            .collect();
+        args.push(path.as_os_str());
+        args.extend(extra.iter().map(OsStr::new));
+        view_under_xvfb(&args);
+        voxcone::imageio::load_rgb(&path).unwrap().0
+    };
+    let panel = shot("panel.png", &[]);
+    let bare = shot("bare.png", &["--no-ui"]);
+    let off = shot("off.png", &["--gi", "off"]);
+    // The panel takes the left 300 pixels.
+    let over_panel = difference(&panel, &bare, 0, 300);
+    let beside = difference(&panel, &bare, 320, 640);
+    eprintln!("panel vs --no-ui: {over_panel:.4} over the panel, {beside:.4} beside it");
+    assert!(over_panel > 0.05, "no panel drawn: {over_panel}");
+    assert!(
+        beside < 0.01,
+        "the panel changed the image beside it: {beside}"
+    );
+
+    let script = dir.join("panel.sh");
+    std::fs::write(
+        &script,
+        [PANEL_CLICK, WAIT_FOR_WINDOW, PANEL_CLICK_ACTIONS].concat(),
+    )
+    .unwrap();
+    let clicked_path = dir.join("clicked.png");
+    let output = under_xvfb(
+        OsStr::new("sh"),
+        &[
+            script.as_os_str(),
+            OsStr::new(env!("CARGO_BIN_EXE_voxcone")),
+            clicked_path.as_os_str(),
+        ],
+    );
+    let err = stderr(&output);
+    assert!(
+        err.contains("rebuilding the renderer"),
+        "the click did nothing: {err}"
+    );
+    let clicked = voxcone::imageio::load_rgb(&clicked_path).unwrap().0;
+    assert_eq!((clicked.width, clicked.height), (640, 400), "not resized");
+    let to_off = difference(&clicked, &off, 320, 640);
+    let to_dense = difference(&clicked, &panel, 320, 640);
+    eprintln!("after the click: {to_off:.4} from --gi off, {to_dense:.4} from dense");
+    assert!(
+        to_off < 0.01 && to_dense > 3.0 * to_off.max(0.003),
+        "{to_off} {to_dense}"
+    );
 }

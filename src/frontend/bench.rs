@@ -95,6 +95,11 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
         before: ImageUse::discard_after(ImageUse::COLOR_ATTACHMENT),
         after: ImageUse::COLOR_ATTACHMENT,
     };
+    let mut panel = args
+        .ui
+        .then(|| super::ui::Panel::new(&ctx, None, super::LDR_FORMAT))
+        .transpose()?;
+    let (mut panel_args, mut speed, mut last_wall) = (args.common.clone(), 1.0, 0.0);
     let mut order: Vec<String> = Vec::new();
     let mut samples: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut totals = Vec::new();
@@ -111,6 +116,15 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
                 centre + radius * glam::Vec3::new(angle.cos() - 1.0, 0.0, angle.sin());
         }
         let start = Instant::now();
+        if let Some(panel) = &mut panel {
+            let view = super::ui::PanelView {
+                renderer: &mut renderer,
+                args: &mut panel_args,
+                speed: &mut speed,
+            };
+            // What it asks for (a rebuild, a screenshot) needs a click: there is none.
+            panel.update(None, extent, view, last_wall)?;
+        }
         let frame = renderer.begin_frame()?;
         let time = if args.animate {
             args.common.time + index as f32 / 30.0
@@ -118,13 +132,20 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
             args.common.time
         };
         renderer.record_frame(&frame, time, &target)?;
+        if let Some(panel) = &mut panel {
+            renderer.record_overlay(&frame, &target, "ui", ImageUse::COLOR_ATTACHMENT, |cmd| {
+                panel.record(cmd, extent)
+            })?;
+        }
         renderer.submit(frame, None, None)?;
         // Waiting for each frame keeps frames from overlapping, so pass times are clean.
         renderer.finish()?;
         if index < args.warmup {
             continue;
         }
-        walls.push(start.elapsed().as_secs_f64() * 1e3);
+        let wall = start.elapsed().as_secs_f64() * 1e3;
+        last_wall = wall as f32;
+        walls.push(wall);
         let measured = index - args.warmup + 1;
         if measured == 1 || measured % 100 == 0 || measured == args.frames {
             rss_mib.extend(resident_mib().map(|m| (measured, m)));

@@ -2,6 +2,7 @@
 
 pub mod bench;
 pub mod render;
+mod ui;
 pub mod view;
 
 use std::ffi::CStr;

@@ -6,7 +6,8 @@
 //! 1 to 6 switch the terms (direct, indirect diffuse, indirect specular, transmission,
 //! ambient occlusion, emission); V cycles the debug views and [ / ] pick the views' mip
 //! level; the technique's own switches have their keys too (the cone tracer's C: shadow
-//! maps or soft-shadow cones).
+//! maps or soft-shadow cones). F1 shows and hides the settings panel (`super::ui`),
+//! which `--no-ui` starts hidden.
 
 use std::collections::HashSet;
 use std::ffi::CStr;
@@ -24,8 +25,9 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
 
+use super::ui::{Panel, PanelView, Request};
 use super::{check_validation, create_context, load_scene};
-use crate::cli::ViewArgs;
+use crate::cli::{CommonArgs, ViewArgs};
 use crate::renderer::{OutputTarget, Renderer};
 use crate::vk::{copy_image_to_buffer, Acquired, Buffer, Context, ImageUse, Swapchain};
 
@@ -44,6 +46,13 @@ struct Viewer {
     /// exit: the resize-storm test reads them).
     recreations: u64,
     hidden_frames: u64,
+    panel: Panel,
+    /// The command line as the panel edits it: a rebuild makes the renderer from it.
+    args: CommonArgs,
+    /// Camera speed multiplier (the panel's).
+    speed: f32,
+    /// Screenshots taken with the panel's button.
+    screenshots: u32,
 }
 
 struct App {
@@ -137,6 +146,8 @@ impl Viewer {
         // Camera speed follows the scene's units; a scene of one point moves by units.
         let scene_size = if diagonal > 0.0 { diagonal } else { 1.0 };
         let renderer = Renderer::new(&ctx, scene, settings, swapchain.extent, swapchain.format)?;
+        let mut panel = Panel::new(&ctx, Some(&window), swapchain.format)?;
+        panel.visible = !args.no_ui;
         let acquired = (0..2)
             .map(|_| unsafe {
                 ctx.device
@@ -153,7 +164,44 @@ impl Viewer {
             scene_size,
             recreations: 0,
             hidden_frames: 0,
+            panel,
+            args: args.common.clone(),
+            speed: 1.0,
+            screenshots: 0,
         })
+    }
+
+    /// Builds the renderer again from the panel's edited command line, keeping the
+    /// scene as it is now (lights moved or added), the camera and the terms. A setting
+    /// the command line would refuse is reported in the panel and changes nothing.
+    fn rebuild(&mut self) -> Result<()> {
+        let settings = match self.args.render_settings(&self.renderer.scene.gi) {
+            Ok(settings) => settings,
+            Err(e) => {
+                self.panel.message = Some(format!("{e:#}"));
+                return Ok(());
+            }
+        };
+        log::info!("rebuilding the renderer for the panel's settings");
+        self.renderer.finish()?;
+        let camera = self.renderer.camera.clone();
+        let terms = self.renderer.settings.terms;
+        match Renderer::new(
+            &self.ctx,
+            self.renderer.scene.clone(),
+            settings,
+            self.swapchain.extent,
+            self.swapchain.format,
+        ) {
+            Ok(mut renderer) => {
+                renderer.camera = camera;
+                renderer.settings.terms = terms;
+                self.renderer = renderer;
+                self.panel.message = None;
+            }
+            Err(e) => self.panel.message = Some(format!("{e:#}")),
+        }
+        Ok(())
     }
 
     fn resize(&mut self) -> Result<()> {
@@ -198,6 +246,12 @@ impl Viewer {
         };
         let readback = screenshot.filter(|_| self.swapchain.readable);
         let extent = self.swapchain.extent;
+        let presented = if readback.is_some() {
+            ImageUse::TRANSFER_SRC
+        } else {
+            ImageUse::PRESENT
+        };
+        let overlay = self.panel.drawn();
         let target = OutputTarget {
             image: self.swapchain.images[index as usize],
             view: self.swapchain.views[index as usize],
@@ -207,13 +261,20 @@ impl Viewer {
                 stage: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
                 access: vk::AccessFlags2::NONE,
             },
-            after: if readback.is_some() {
-                ImageUse::TRANSFER_SRC
+            after: if overlay {
+                ImageUse::COLOR_ATTACHMENT
             } else {
-                ImageUse::PRESENT
+                presented
             },
         };
         self.renderer.record_frame(&frame, time_s, &target)?;
+        if overlay {
+            let panel = &mut self.panel;
+            self.renderer
+                .record_overlay(&frame, &target, "ui", presented, |cmd| {
+                    panel.record(cmd, extent)
+                })?;
+        }
         let buffer = match readback {
             Some(_) => {
                 let buffer = Buffer::new(
@@ -228,13 +289,7 @@ impl Viewer {
                     &self.ctx,
                     frame.cmd,
                     target.image,
-                    vk::ImageSubresourceRange {
-                        aspect_mask: vk::ImageAspectFlags::COLOR,
-                        base_mip_level: 0,
-                        level_count: 1,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    },
+                    crate::vk::COLOR_TARGET_RANGE,
                     ImageUse::TRANSFER_SRC,
                     ImageUse::PRESENT,
                 );
@@ -271,6 +326,7 @@ impl Viewer {
         let right = forward.cross(camera.up).normalize_or_zero();
         let speed = self.scene_size
             * 0.25
+            * self.speed
             * if keys.contains(&KeyCode::ShiftLeft) {
                 4.0
             } else {
@@ -402,17 +458,40 @@ impl App {
             return;
         };
         let now = Instant::now();
-        let dt = (now - self.last_tick).as_secs_f32().min(0.25);
+        let frame_ms = (now - self.last_tick).as_secs_f32() * 1e3;
+        let dt = (frame_ms * 1e-3).min(0.25);
         self.last_tick = now;
         viewer.update_controls(&self.keys, dt);
+        let view = PanelView {
+            renderer: &mut viewer.renderer,
+            args: &mut viewer.args,
+            speed: &mut viewer.speed,
+        };
+        let extent = viewer.swapchain.extent;
+        let requests = match viewer
+            .panel
+            .update(Some(&viewer.window), extent, view, frame_ms)
+        {
+            Ok(requests) => requests,
+            Err(e) => return self.fail(event_loop, e),
+        };
+        if requests.contains(&Request::Rebuild) {
+            if let Err(e) = viewer.rebuild() {
+                return self.fail(event_loop, e);
+            }
+        }
         let last = self.args.frames.is_some_and(|n| self.frames + 1 >= n);
+        let button = requests.contains(&Request::Screenshot).then(|| {
+            viewer.screenshots += 1;
+            PathBuf::from(format!("voxcone-screenshot-{}.png", viewer.screenshots))
+        });
         let screenshot = if last {
-            self.args.screenshot.as_ref()
+            self.args.screenshot.clone()
         } else {
-            None
+            button
         };
         let time_s = (now - self.start).as_secs_f32() + self.args.common.time;
-        if let Err(e) = viewer.draw(time_s, screenshot) {
+        if let Err(e) = viewer.draw(time_s, screenshot.as_ref()) {
             self.fail(event_loop, e);
             return;
         }
@@ -475,6 +554,12 @@ impl ApplicationHandler for App {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        // The panel sees every event first; what it uses (a click on it, typing in it)
+        // does not reach the viewer's controls.
+        let used = self
+            .viewer
+            .as_mut()
+            .is_some_and(|v| v.panel.on_event(&v.window, &event));
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(_) => {
@@ -485,9 +570,14 @@ impl ApplicationHandler for App {
             WindowEvent::KeyboardInput { event, .. } => {
                 if let PhysicalKey::Code(code) = event.physical_key {
                     match event.state {
+                        ElementState::Pressed if used && code != KeyCode::Escape => {}
                         ElementState::Pressed => {
                             if code == KeyCode::Escape {
                                 event_loop.exit();
+                            } else if code == KeyCode::F1 && !event.repeat {
+                                if let Some(viewer) = self.viewer.as_mut() {
+                                    viewer.panel.visible = !viewer.panel.visible;
+                                }
                             } else if !event.repeat {
                                 if let Some(message) =
                                     self.viewer.as_mut().and_then(|v| v.switch(code))
@@ -508,7 +598,11 @@ impl ApplicationHandler for App {
                 button: MouseButton::Left,
                 ..
             } => {
-                self.dragging = state == ElementState::Pressed;
+                let over_panel = self
+                    .viewer
+                    .as_ref()
+                    .is_some_and(|v| v.panel.wants_pointer());
+                self.dragging = state == ElementState::Pressed && !over_panel && !used;
             }
             WindowEvent::CursorMoved { position, .. } => {
                 if let (Some((x, y)), true, Some(viewer)) =

@@ -7,6 +7,15 @@ use ash::vk;
 
 use super::{Buffer, Context, Image};
 
+/// The colour aspect of mip level 0, layer 0: a swapchain image or a 2D render target.
+pub const COLOR_TARGET_RANGE: vk::ImageSubresourceRange = vk::ImageSubresourceRange {
+    aspect_mask: vk::ImageAspectFlags::COLOR,
+    base_mip_level: 0,
+    level_count: 1,
+    base_array_layer: 0,
+    layer_count: 1,
+};
+
 /// One side of an image barrier: a layout with the stages and accesses that use it.
 #[derive(Clone, Copy, Debug)]
 pub struct ImageUse {

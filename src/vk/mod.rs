@@ -13,7 +13,7 @@ mod timestamps;
 pub use commands::{
     clear_to_zero, compute_to_compute, copies_to_host_barrier, copy_image_to_buffer, image_barrier,
     memory_barrier, read_back_buffer, read_back_image, stage_barrier, to_compute_write,
-    update_buffer, ImageUse, OneShot,
+    update_buffer, ImageUse, OneShot, COLOR_TARGET_RANGE,
 };
 pub use context::{Context, ContextOptions, Features};
 pub use descriptors::{Binding, DescriptorSets, SetWriter};

@@ -5,7 +5,7 @@ use clap::Args;
 use super::PathSettings;
 use crate::scene::GiOverrides;
 
-#[derive(Args, Debug, Clone)]
+#[derive(Args, Debug, Clone, Default)]
 pub struct PathArgs {
     /// `--gi path`: samples per pixel [default: the scene file's, else 256].
     #[arg(long)]

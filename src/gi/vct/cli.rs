@@ -8,7 +8,7 @@ use super::voxelize::Voxelizer;
 use super::{check_voxels, ConeSettings, Store, VctSettings, DEFAULT_VOXELS};
 use crate::scene::GiOverrides;
 
-#[derive(Args, Debug, Clone)]
+#[derive(Args, Debug, Clone, Default)]
 pub struct VctArgs {
     /// Voxels per axis of the dense grid, a power of two from 4 to 1024 [default: 64,
     /// or the scene file's [gi] voxels].
