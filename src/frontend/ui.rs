@@ -397,12 +397,29 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             let mut aperture = vct.cones.diffuse_aperture_deg;
             let mut bounces = vct.cones.bounces;
             let mut step = vct.cones.step_factor;
+            let mut bounce_step = vct.cones.bounce_step_factor;
+            let mut shadow_step = vct.cones.shadow_step_factor;
+            let mut shadow_aperture = vct.cones.shadow_aperture_deg;
+            let mut ao_distance = vct.cones.ao_distance_voxels;
+            let mut scale = vct.cones.indirect_scale.unwrap_or(0);
             let mut shadow_cones = vct.shadow_cones;
             let octree = view.args.gi == GiMode::Octree;
             settle(ui.add(egui::Slider::new(&mut cones, 1..=16).text("diffuse cones")));
             settle(ui.add(egui::Slider::new(&mut aperture, 10.0..=120.0).text("aperture (deg)")));
             settle(ui.add(egui::Slider::new(&mut step, 0.1..=1.0).text("step factor")));
+            settle(
+                ui.add(egui::Slider::new(&mut bounce_step, 0.1..=1.0).text("bounce step factor")),
+            );
             settle(ui.add(egui::Slider::new(&mut bounces, 1..=8).text("bounces")));
+            settle(
+                ui.add(egui::Slider::new(&mut scale, 0..=8).text("indirect scale"))
+                    .on_hover_text("trace one pixel of each N×N block; 0: by the image height"),
+            );
+            settle(
+                ui.add(
+                    egui::Slider::new(&mut ao_distance, 0.5..=16.0).text("AO distance (voxels)"),
+                ),
+            );
             if octree {
                 let mut depth = vct.voxels.trailing_zeros();
                 settle(ui.add(egui::Slider::new(&mut depth, 6..=10).text("octree depth")));
@@ -423,6 +440,17 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                 }
             }
             settle(ui.checkbox(&mut shadow_cones, "soft-shadow cones"));
+            if shadow_cones {
+                settle(
+                    ui.add(
+                        egui::Slider::new(&mut shadow_aperture, 0.5..=30.0)
+                            .text("shadow aperture (deg)"),
+                    ),
+                );
+                settle(ui.add(
+                    egui::Slider::new(&mut shadow_step, 0.1..=1.0).text("shadow step factor"),
+                ));
+            }
             if cones != vct.cones.diffuse_cones {
                 args.diffuse_cones = Some(cones);
             }
@@ -434,6 +462,21 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             }
             if bounces != vct.cones.bounces {
                 args.bounces = Some(bounces);
+            }
+            if bounce_step != vct.cones.bounce_step_factor {
+                args.bounce_step_factor = Some(bounce_step);
+            }
+            if shadow_step != vct.cones.shadow_step_factor {
+                args.shadow_step_factor = Some(shadow_step);
+            }
+            if shadow_aperture != vct.cones.shadow_aperture_deg {
+                args.shadow_aperture = Some(shadow_aperture);
+            }
+            if ao_distance != vct.cones.ao_distance_voxels {
+                args.ao_distance = Some(ao_distance);
+            }
+            if scale != vct.cones.indirect_scale.unwrap_or(0) {
+                args.indirect_scale = (scale > 0).then_some(scale);
             }
             args.shadow_cones = shadow_cones;
         }
@@ -448,6 +491,14 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             );
             if spp != path.spp {
                 view.args.path.spp = Some(spp);
+            }
+            let mut depth = path.max_depth.unwrap_or(0);
+            settle(
+                ui.add(egui::Slider::new(&mut depth, 0..=32).text("longest path"))
+                    .on_hover_text("vertices of the longest path; 0: no limit"),
+            );
+            if depth != path.max_depth.unwrap_or(0) {
+                view.args.path.max_depth = (depth > 0).then_some(depth);
             }
             if let Some(p) = view.renderer.gi().and_then(|t| t.progress()) {
                 ui.add(
@@ -472,13 +523,21 @@ fn lights(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
         let mut remove = None;
         for (i, light) in lights.iter_mut().enumerate() {
             ui.push_id(i, |ui| {
-                let kind = match light.kind {
-                    LightKind::Point => "point",
-                    LightKind::Spot { .. } => "spot",
-                    LightKind::Directional { .. } => "directional",
-                };
                 ui.horizontal(|ui| {
-                    ui.label(format!("{i}: {kind}"));
+                    ui.label(format!("{i}:"));
+                    let before = kind_name(&light.kind);
+                    let mut kind = before;
+                    egui::ComboBox::from_id_salt("kind")
+                        .selected_text(kind)
+                        .show_ui(ui, |ui| {
+                            for k in ["point", "spot", "directional"] {
+                                ui.selectable_value(&mut kind, k, k);
+                            }
+                        });
+                    if kind != before {
+                        light.kind = kind_named(kind, light.kind);
+                        rebuild = true;
+                    }
                     if ui.small_button("remove").clicked() {
                         remove = Some(i);
                     }
@@ -492,6 +551,7 @@ fn lights(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                         }
                     });
                 }
+                direction_and_cone(ui, &mut light.kind);
                 colour_and_intensity(ui, light);
             });
         }
@@ -510,6 +570,64 @@ fn lights(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
         }
     });
     rebuild
+}
+
+fn kind_name(kind: &LightKind) -> &'static str {
+    match kind {
+        LightKind::Point => "point",
+        LightKind::Spot { .. } => "spot",
+        LightKind::Directional { .. } => "directional",
+    }
+}
+
+/// The light kind `name`, keeping the direction of `old` where it has one (a new one
+/// points down); a new spot's cone is 20 to 30 degrees.
+fn kind_named(name: &str, old: LightKind) -> LightKind {
+    let direction = match old {
+        LightKind::Spot { direction, .. } | LightKind::Directional { direction } => direction,
+        LightKind::Point => Vec3::NEG_Y,
+    };
+    match name {
+        "spot" => LightKind::Spot {
+            direction,
+            inner_deg: 20.0,
+            outer_deg: 30.0,
+        },
+        "directional" => LightKind::Directional { direction },
+        _ => LightKind::Point,
+    }
+}
+
+/// A spot's or sun's direction (kept unit length) and a spot's cone, edited live.
+fn direction_and_cone(ui: &mut egui::Ui, kind: &mut LightKind) {
+    let (direction, cone) = match kind {
+        LightKind::Point => return,
+        LightKind::Spot {
+            direction,
+            inner_deg,
+            outer_deg,
+        } => (direction, Some((inner_deg, outer_deg))),
+        LightKind::Directional { direction } => (direction, None),
+    };
+    let mut d = *direction;
+    ui.horizontal(|ui| {
+        ui.label("direction");
+        for c in 0..3 {
+            ui.add(
+                egui::DragValue::new(&mut d[c])
+                    .speed(0.01)
+                    .range(-1.0..=1.0),
+            );
+        }
+    });
+    if d.length_squared() > 1e-6 {
+        *direction = d.normalize();
+    }
+    if let Some((inner, outer)) = cone {
+        ui.add(egui::Slider::new(outer, 1.0..=89.0).text("outer (deg)"));
+        let top = *outer;
+        ui.add(egui::Slider::new(inner, 0.0..=top).text("inner (deg)"));
+    }
 }
 
 /// A light's colour (its intensity over the largest channel) and that largest channel.

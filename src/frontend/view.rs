@@ -91,9 +91,10 @@ pub fn run(args: ViewArgs) -> Result<()> {
     }
     if let Some(viewer) = app.viewer.take() {
         log::info!(
-            "viewer closed after {} frames: {} swapchain recreations, {} frames with nothing \
-             to present to",
+            "viewer closed after {} frames ({:.1} ms per frame): {} swapchain recreations, {} \
+             frames with nothing to present to",
             app.frames,
+            app.start.elapsed().as_secs_f64() * 1e3 / app.frames.max(1) as f64,
             viewer.recreations,
             viewer.hidden_frames
         );
