@@ -210,7 +210,10 @@ const PANEL_CLICK_ACTIONS: &str = r#"
 sleep 3
 xdotool windowsize --sync $wid 640 400
 sleep 1
-xdotool mousemove --window $wid 20 53 click 1
+# egui presses what the pointer hovered over in an earlier frame: move, then click.
+xdotool mousemove --window $wid 20 53
+sleep 1
+xdotool click 1
 wait $pid
 "#;
 

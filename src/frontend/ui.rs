@@ -23,9 +23,11 @@ use winit::window::Window;
 use crate::cli::{CommonArgs, GiMode};
 use crate::gi::path::cli::PathArgs;
 use crate::gi::vct::cli::VctArgs;
+use crate::gi::vct::voxelize::Voxelizer;
 use crate::gi::{DebugView, GiSettings};
 use crate::renderer::{Renderer, FRAMES_IN_FLIGHT};
 use crate::scene::{Light, LightKind};
+use crate::settings::Tonemap;
 use crate::vk::Context;
 
 /// Frames of the frame-time graph.
@@ -69,6 +71,8 @@ pub struct Panel {
     frames: u64,
     /// The last rebuild's error, shown until the next rebuild.
     pub message: Option<String>,
+    /// A rebuild is asked for: this frame says so, the next one does it.
+    pub building: bool,
 }
 
 impl Panel {
@@ -127,6 +131,7 @@ impl Panel {
             stats: Vec::new(),
             frames: 0,
             message: None,
+            building: false,
         })
     }
 
@@ -182,6 +187,7 @@ impl Panel {
             frame_ms: &self.frame_ms,
             stats: &self.stats,
             message: self.message.as_deref(),
+            building: self.building,
         };
         let mut view = view;
         let output = self.egui.run_ui(input, |ui| {
@@ -255,6 +261,7 @@ struct Shown<'a> {
     frame_ms: &'a VecDeque<f32>,
     stats: &'a [(String, f64)],
     message: Option<&'a str>,
+    building: bool,
 }
 
 const TECHNIQUES: [(GiMode, &str); 4] = [
@@ -268,6 +275,12 @@ fn contents(ui: &mut egui::Ui, view: &mut PanelView, shown: &Shown, requests: &m
     ui.heading("voxcone");
     if let Some(message) = shown.message {
         ui.colored_label(Color32::LIGHT_RED, message);
+    }
+    if shown.building {
+        ui.colored_label(
+            Color32::YELLOW,
+            "building the renderer… (the terminal shows its progress)",
+        );
     }
     let mut rebuild = false;
 
@@ -318,7 +331,7 @@ fn contents(ui: &mut egui::Ui, view: &mut PanelView, shown: &Shown, requests: &m
 
     rebuild |= lights(ui, view);
 
-    egui::CollapsingHeader::new("Camera").show(ui, |ui| {
+    egui::CollapsingHeader::new("Camera and display").show(ui, |ui| {
         ui.add(
             egui::Slider::new(view.speed, 0.05..=10.0)
                 .logarithmic(true)
@@ -328,6 +341,13 @@ fn contents(ui: &mut egui::Ui, view: &mut PanelView, shown: &Shown, requests: &m
             egui::Slider::new(&mut view.renderer.camera.fov_y_deg, 10.0..=120.0)
                 .text("field of view (deg)"),
         );
+        let settings = &mut view.renderer.settings;
+        ui.add(egui::Slider::new(&mut settings.exposure_ev, -8.0..=8.0).text("exposure (EV)"));
+        ui.horizontal(|ui| {
+            ui.label("tonemap");
+            ui.selectable_value(&mut settings.tonemap, Tonemap::Clamp, "clamp");
+            ui.selectable_value(&mut settings.tonemap, Tonemap::Aces, "ACES");
+        });
     });
 
     egui::CollapsingHeader::new("GPU times")
@@ -438,6 +458,26 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                 if voxels != vct.voxels {
                     args.voxels = Some(voxels);
                 }
+            }
+            let mut wide = vct.cones.wide_steps_by_level;
+            let mut accumulate = vct.cones.accumulate_bounces;
+            let mut full_update = vct.full_update;
+            let mut voxelizer = vct.voxelizer;
+            settle(ui.checkbox(&mut wide, "wide steps by level"));
+            settle(ui.checkbox(&mut accumulate, "accumulate bounces over frames"));
+            settle(ui.checkbox(&mut full_update, "voxelize everything every frame"));
+            egui::ComboBox::from_label("voxelizer")
+                .selected_text(format!("{voxelizer:?}"))
+                .show_ui(ui, |ui| {
+                    for v in [Voxelizer::Auto, Voxelizer::Raster, Voxelizer::Compute] {
+                        settle(ui.selectable_value(&mut voxelizer, v, format!("{v:?}")));
+                    }
+                });
+            args.wide_steps_by_level = wide;
+            args.no_accumulate = !accumulate;
+            args.full_update = full_update;
+            if voxelizer != vct.voxelizer {
+                args.voxelizer = voxelizer;
             }
             settle(ui.checkbox(&mut shadow_cones, "soft-shadow cones"));
             if shadow_cones {

@@ -285,6 +285,14 @@ impl Viewer {
                     vk::BufferUsageFlags::TRANSFER_DST,
                     gpu_allocator::MemoryLocation::GpuToCpu,
                 )?;
+                // A new buffer may reuse the memory of an earlier screenshot's, whose copy
+                // the host read: order this copy after that one.
+                crate::vk::stage_barrier(
+                    &self.ctx,
+                    frame.cmd,
+                    vk::PipelineStageFlags2::COPY,
+                    vk::PipelineStageFlags2::COPY,
+                );
                 copy_image_to_buffer(&self.ctx, frame.cmd, target.image, extent, buffer.raw);
                 crate::vk::image_barrier(
                     &self.ctx,
@@ -463,6 +471,13 @@ impl App {
         let dt = (frame_ms * 1e-3).min(0.25);
         self.last_tick = now;
         viewer.update_controls(&self.keys, dt);
+        if viewer.panel.building {
+            // The last frame said the rebuild was coming; it blocks until done.
+            viewer.panel.building = false;
+            if let Err(e) = viewer.rebuild() {
+                return self.fail(event_loop, e);
+            }
+        }
         let view = PanelView {
             renderer: &mut viewer.renderer,
             args: &mut viewer.args,
@@ -477,9 +492,7 @@ impl App {
             Err(e) => return self.fail(event_loop, e),
         };
         if requests.contains(&Request::Rebuild) {
-            if let Err(e) = viewer.rebuild() {
-                return self.fail(event_loop, e);
-            }
+            viewer.panel.building = true;
         }
         let last = self.args.frames.is_some_and(|n| self.frames + 1 >= n);
         let button = requests.contains(&Request::Screenshot).then(|| {
