@@ -1,7 +1,7 @@
 //! Progress of long work: scene parsing, texture decoding, octree builds, path-traced
 //! renders. On a terminal a bar shows the items done and the time left; elsewhere (CI
-//! logs, pipes) the bar stays hidden and work that runs longer than a few seconds logs a
-//! plain line at each quarter instead.
+//! logs, pipes) the bar stays hidden and work expected to run longer than a few seconds
+//! logs a plain line at each quarter instead.
 
 use std::io::{BufRead, Read};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-/// Work shorter than this logs no quarter lines.
+/// Work expected to take less than this in all logs no quarter lines.
 const QUIET: Duration = Duration::from_secs(2);
 
 /// The progress of `total` items of one phase. Shared across threads by reference.
@@ -79,13 +79,15 @@ impl Progress {
 
     fn show(&self, done: u64) {
         self.bar.set_position(done);
-        if !self.bar.is_hidden() || self.start.elapsed() < QUIET {
+        if !self.bar.is_hidden() {
             return;
         }
         let quarter = 4 * done / self.total.max(1);
         let last = self.quarter.fetch_max(quarter, Ordering::Relaxed);
-        if quarter > last && quarter < 4 {
-            let elapsed = self.start.elapsed().as_secs_f64();
+        let elapsed = self.start.elapsed().as_secs_f64();
+        // The whole work's time as the part done predicts it.
+        let expected = elapsed * self.total as f64 / done.max(1) as f64;
+        if quarter > last && quarter < 4 && expected >= QUIET.as_secs_f64() {
             let left = elapsed * (self.total - done.min(self.total)) as f64 / done.max(1) as f64;
             log::info!(
                 "{}: {done} of {}{}{} done, {elapsed:.0} s so far, about {left:.0} s left",
