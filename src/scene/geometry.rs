@@ -11,7 +11,7 @@ use anyhow::{bail, Context as _, Result};
 use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 
-use super::texture::AlphaCutout;
+use super::texture::Adjust;
 use super::{Aabb, Animation, Camera, Light, LoadOptions, Material, Mesh, Texture};
 use super::{TextureKind, Vertex};
 use crate::progress::Progress;
@@ -224,14 +224,14 @@ impl TextureSource {
 struct TextureRequest {
     source: TextureSource,
     kind: TextureKind,
-    cutout: Option<AlphaCutout>,
+    adjust: Option<Adjust>,
     material: String,
 }
 
-/// Textures requested by materials, each (image, kind, cut-out) once.
+/// Textures requested by materials, each (image, kind, adjustment) once.
 #[derive(Default)]
 pub(super) struct TextureRequests {
-    index: HashMap<(PathBuf, TextureKind, Option<[u32; 2]>), u32>,
+    index: HashMap<(PathBuf, TextureKind, Option<[u32; 3]>), u32>,
     list: Vec<TextureRequest>,
 }
 
@@ -260,19 +260,15 @@ impl TextureRequests {
     }
 
     /// A texture from `source` (a file's existence checked by the caller). Requests with
-    /// the same source name, kind and cut-out share one texture.
+    /// the same source name, kind and adjustment share one texture.
     pub fn request(
         &mut self,
         source: TextureSource,
         kind: TextureKind,
-        cutout: Option<AlphaCutout>,
+        adjust: Option<Adjust>,
         material: &str,
     ) -> u32 {
-        let key = (
-            source.name().to_path_buf(),
-            kind,
-            cutout.map(|c| [c.factor.to_bits(), c.cutoff.to_bits()]),
-        );
+        let key = (source.name().to_path_buf(), kind, adjust.map(|a| a.key()));
         if let Some(&index) = self.index.get(&key) {
             return index;
         }
@@ -280,7 +276,7 @@ impl TextureRequests {
         self.list.push(TextureRequest {
             source,
             kind,
-            cutout,
+            adjust,
             material: material.to_string(),
         });
         self.index.insert(key, index);
@@ -298,9 +294,9 @@ impl TextureRequests {
             .par_iter()
             .map(|r| {
                 let texture = match &r.source {
-                    TextureSource::File(path) => Texture::load(path, r.kind, r.cutout),
+                    TextureSource::File(path) => Texture::load(path, r.kind, r.adjust),
                     TextureSource::Memory { name, bytes } => {
-                        Texture::decode(name, bytes, r.kind, r.cutout)
+                        Texture::decode(name, bytes, r.kind, r.adjust)
                     }
                 }
                 .with_context(|| format!("texture of material {:?}", r.material));

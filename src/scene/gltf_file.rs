@@ -19,7 +19,7 @@
 //!   (`AlphaCutout`); `BLEND` becomes the transmission `d` = the factor's alpha, the
 //!   texture's alpha a cut-out at one half.
 //! - **Textures**: sRGB base colour and emissive, linear normal maps (the format's +Y up
-//!   convention, as voxcone's OBJ normal maps). `KHR_texture_transform` of the base colour
+//!   convention, as voxcone's OBJ normal maps; `scale` applied to the texels at load). `KHR_texture_transform` of the base colour
 //!   texture (else the emissive, else the normal map) is baked into the vertices' one set
 //!   of texture coordinates; a material whose textures differ in transform or set is
 //!   loaded with a warning.
@@ -45,7 +45,9 @@ use super::file::folder;
 use super::geometry::{
     model_geometry, FileSetup, Geometry, MeshEntry, ModelAttributes, ModelGeometry, TextureSource,
 };
-use super::{AlphaCutout, Camera, Light, LightKind, LoadOptions, Material, Mesh, TextureKind};
+use super::{
+    Adjust, AlphaCutout, Camera, Light, LightKind, LoadOptions, Material, Mesh, TextureKind,
+};
 use crate::progress::Progress;
 
 /// Lumens per watt: glTF's photometric light units to voxcone's radiometric ones.
@@ -486,9 +488,9 @@ impl GltfFile<'_> {
                 }),
             ),
         };
-        let mut texture = |this: &mut Self, t: gltf::Texture, kind, cutout| -> Result<u32> {
+        let mut texture = |this: &mut Self, t: gltf::Texture, kind, adjust| -> Result<u32> {
             let source = this.image(&t.source())?;
-            Ok(geometry.textures.request(source, kind, cutout, &name))
+            Ok(geometry.textures.request(source, kind, adjust, &name))
         };
         let albedo_texture = base_texture
             .as_ref()
@@ -499,7 +501,7 @@ impl GltfFile<'_> {
                 self,
                 t.texture(),
                 TextureKind::Coverage,
-                Some(cutout),
+                Some(Adjust::Cutout(cutout)),
             )?),
             _ => None,
         };
@@ -509,13 +511,13 @@ impl GltfFile<'_> {
             .transpose()?;
         let normal_texture = match m.normal_texture() {
             Some(n) if !self.options.no_normal_maps => {
-                if n.scale() != 1.0 {
-                    log::warn!(
-                        "{name}: normalTexture.scale {} is not used (1 is)",
-                        n.scale()
-                    );
-                }
-                Some(texture(self, n.texture(), TextureKind::Normal, None)?)
+                ensure!(
+                    n.scale().is_finite(),
+                    "normalTexture.scale must be finite, got {}",
+                    n.scale()
+                );
+                let scale = (n.scale() != 1.0).then_some(Adjust::NormalScale(n.scale()));
+                Some(texture(self, n.texture(), TextureKind::Normal, scale)?)
             }
             _ => None,
         };

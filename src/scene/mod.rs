@@ -23,7 +23,7 @@ use glam::{Mat4, Vec3};
 pub use animation::{Animation, Orbit};
 pub use camera::Camera;
 pub use light::{Light, LightKind};
-pub use texture::{AlphaCutout, Texture, TextureKind};
+pub use texture::{Adjust, AlphaCutout, Texture, TextureKind};
 
 /// One vertex, as uploaded to the GPU.
 ///

@@ -57,15 +57,35 @@ impl AlphaCutout {
     }
 }
 
+/// A conversion of a texture's texels at load time, beyond its kind's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Adjust {
+    /// A coverage texture from the image's alpha.
+    Cutout(AlphaCutout),
+    /// A normal map's tangent-plane components times this (glTF `normalTexture.scale`),
+    /// renormalised, as the format's shaders do per sample.
+    NormalScale(f32),
+}
+
+impl Adjust {
+    /// The adjustment's identity, for telling textures apart.
+    pub fn key(&self) -> [u32; 3] {
+        match self {
+            Adjust::Cutout(c) => [0, c.factor.to_bits(), c.cutoff.to_bits()],
+            Adjust::NormalScale(scale) => [1, scale.to_bits(), 0],
+        }
+    }
+}
+
 impl Texture {
-    /// Decodes image file `path` as `kind` (with `cutout`, the coverage of its alpha).
-    pub fn load(path: &Path, kind: TextureKind, cutout: Option<AlphaCutout>) -> Result<Texture> {
+    /// Decodes image file `path` as `kind`, with `adjust`.
+    pub fn load(path: &Path, kind: TextureKind, adjust: Option<Adjust>) -> Result<Texture> {
         let image = image::ImageReader::open(path)
             .and_then(|r| r.with_guessed_format())
             .with_context(|| format!("cannot read texture {}", path.display()))?
             .decode()
             .with_context(|| format!("cannot decode texture {}", path.display()))?;
-        Self::checked(path, kind, cutout, &image)
+        Self::checked(path, kind, adjust, &image)
     }
 
     /// Decodes the encoded image `bytes` (named `name` in messages).
@@ -73,17 +93,17 @@ impl Texture {
         name: &Path,
         bytes: &[u8],
         kind: TextureKind,
-        cutout: Option<AlphaCutout>,
+        adjust: Option<Adjust>,
     ) -> Result<Texture> {
         let image = image::load_from_memory(bytes)
             .with_context(|| format!("cannot decode texture {}", name.display()))?;
-        Self::checked(name, kind, cutout, &image)
+        Self::checked(name, kind, adjust, &image)
     }
 
     fn checked(
         path: &Path,
         kind: TextureKind,
-        cutout: Option<AlphaCutout>,
+        adjust: Option<Adjust>,
         image: &DynamicImage,
     ) -> Result<Texture> {
         ensure!(
@@ -91,23 +111,24 @@ impl Texture {
             "texture {} is empty",
             path.display()
         );
-        Ok(Texture::from_image(path.to_path_buf(), kind, cutout, image))
+        Ok(Texture::from_image(path.to_path_buf(), kind, adjust, image))
     }
 
     /// Converts a decoded, non-empty image for `kind` and builds its mips.
     fn from_image(
         path: PathBuf,
         kind: TextureKind,
-        cutout: Option<AlphaCutout>,
+        adjust: Option<Adjust>,
         image: &DynamicImage,
     ) -> Texture {
         let (width, height) = (image.width(), image.height());
-        let level0 = match (kind, cutout) {
-            (TextureKind::Coverage, Some(cutout)) => alpha_coverage(image, cutout),
+        let level0 = match (kind, adjust) {
+            (TextureKind::Coverage, Some(Adjust::Cutout(cutout))) => alpha_coverage(image, cutout),
+            (TextureKind::Normal, Some(Adjust::NormalScale(scale))) => scaled_normals(image, scale),
             // Float images hold linear values; bytes of an albedo texture must be sRGB.
             (TextureKind::Albedo, _) if is_float(image) => rgba32f_to_srgb8(image),
             (TextureKind::Albedo | TextureKind::Normal, _) => image.to_rgba8().into_raw(),
-            (TextureKind::Coverage, None) => coverage(image),
+            (TextureKind::Coverage, _) => coverage(image),
         };
         Texture {
             path,
@@ -136,6 +157,19 @@ fn rgba32f_to_srgb8(image: &DynamicImage) -> Vec<u8> {
         .to_rgba32f()
         .pixels()
         .flat_map(|p| srgba8_encode(p.0))
+        .collect()
+}
+
+/// Normals of a normal map with x and y times `scale`, renormalised (alpha kept).
+fn scaled_normals(image: &DynamicImage, scale: f32) -> Vec<u8> {
+    image
+        .to_rgba8()
+        .pixels()
+        .flat_map(|p| {
+            let v = decode(TextureKind::Normal, &p.0);
+            let n = (v.truncate() * Vec3::new(scale, scale, 1.0)).normalize_or(Vec3::Z);
+            encode(TextureKind::Normal, n.extend(v.w))
+        })
         .collect()
 }
 
@@ -315,7 +349,7 @@ mod tests {
         let t = Texture::from_image(
             PathBuf::new(),
             TextureKind::Coverage,
-            Some(cutout),
+            Some(Adjust::Cutout(cutout)),
             &DynamicImage::ImageRgba8(image),
         );
         let kept: Vec<bool> = t.mips[0]
@@ -335,6 +369,29 @@ mod tests {
             cutoff: 0.0,
         };
         assert!(all.coverage(0.0) >= 0.5, "cutoff 0 keeps everything");
+    }
+
+    #[test]
+    fn normal_scale_tilts_the_normals() {
+        // A normal tilted 45 degrees towards +X; scale 0 flattens it, 2 tilts it further.
+        let image = RgbaImage::from_pixel(1, 1, Rgba([218, 128, 218, 255]));
+        let tilt = |scale: f32| {
+            let t = Texture::from_image(
+                PathBuf::new(),
+                TextureKind::Normal,
+                Some(Adjust::NormalScale(scale)),
+                &DynamicImage::ImageRgba8(image.clone()),
+            );
+            let v = decode(TextureKind::Normal, &t.mips[0]);
+            v.x.atan2(v.z).to_degrees()
+        };
+        assert!(tilt(0.0).abs() < 0.5, "{}", tilt(0.0));
+        assert!((tilt(1.0) - 45.0).abs() < 1.0, "{}", tilt(1.0));
+        assert!(
+            (tilt(2.0) - 2f32.atan().to_degrees()).abs() < 1.0,
+            "{}",
+            tilt(2.0)
+        );
     }
 
     #[test]

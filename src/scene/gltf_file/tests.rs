@@ -196,7 +196,9 @@ fn node_hierarchy_materials_texture_transform_camera_and_lights() {
             "emissiveFactor": [1.0, 2.0, 3.0],
             "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0}},
             "emissiveTexture": {"index": 0,
-                                "extensions": {"KHR_texture_transform": transform}}
+                                "extensions": {"KHR_texture_transform": transform}},
+            "normalTexture": {"index": 0, "scale": 0.5,
+                              "extensions": {"KHR_texture_transform": transform}}
         }],
         "textures": [{"source": 0}],
         "images": [{"uri": "albedo.png"}],
@@ -261,6 +263,8 @@ fn node_hierarchy_materials_texture_transform_camera_and_lights() {
         m.albedo_texture, m.emission_texture,
         "one image, one sRGB texture"
     );
+    // The same image as a normal map scaled by one half: a texture of its own.
+    assert!(m.normal_texture.is_some() && m.normal_texture != m.albedo_texture);
     assert_eq!((m.dissolve, m.coverage_texture), (1.0, None));
 
     // Camera 0 (the first by index), on the node looking down.
