@@ -443,9 +443,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             if octree {
                 let mut depth = vct.voxels.trailing_zeros();
                 settle(ui.add(egui::Slider::new(&mut depth, 6..=10).text("octree depth")));
-                if depth != vct.voxels.trailing_zeros() {
-                    args.octree_depth = Some(depth);
-                }
+                override_if(&mut args.octree_depth, depth, vct.voxels.trailing_zeros());
             } else {
                 let mut voxels = vct.voxels;
                 egui::ComboBox::from_label("voxels")
@@ -455,9 +453,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                             settle(ui.selectable_value(&mut voxels, v, format!("{v}³")));
                         }
                     });
-                if voxels != vct.voxels {
-                    args.voxels = Some(voxels);
-                }
+                override_if(&mut args.voxels, voxels, vct.voxels);
             }
             let mut wide = vct.cones.wide_steps_by_level;
             let mut accumulate = vct.cones.accumulate_bounces;
@@ -491,30 +487,27 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                     egui::Slider::new(&mut shadow_step, 0.1..=1.0).text("shadow step factor"),
                 ));
             }
-            if cones != vct.cones.diffuse_cones {
-                args.diffuse_cones = Some(cones);
-            }
-            if aperture != vct.cones.diffuse_aperture_deg {
-                args.diffuse_aperture = Some(aperture);
-            }
-            if step != vct.cones.step_factor {
-                args.step_factor = Some(step);
-            }
-            if bounces != vct.cones.bounces {
-                args.bounces = Some(bounces);
-            }
-            if bounce_step != vct.cones.bounce_step_factor {
-                args.bounce_step_factor = Some(bounce_step);
-            }
-            if shadow_step != vct.cones.shadow_step_factor {
-                args.shadow_step_factor = Some(shadow_step);
-            }
-            if shadow_aperture != vct.cones.shadow_aperture_deg {
-                args.shadow_aperture = Some(shadow_aperture);
-            }
-            if ao_distance != vct.cones.ao_distance_voxels {
-                args.ao_distance = Some(ao_distance);
-            }
+            let c = &vct.cones;
+            override_if(&mut args.diffuse_cones, cones, c.diffuse_cones);
+            override_if(&mut args.diffuse_aperture, aperture, c.diffuse_aperture_deg);
+            override_if(&mut args.step_factor, step, c.step_factor);
+            override_if(&mut args.bounces, bounces, c.bounces);
+            override_if(
+                &mut args.bounce_step_factor,
+                bounce_step,
+                c.bounce_step_factor,
+            );
+            override_if(
+                &mut args.shadow_step_factor,
+                shadow_step,
+                c.shadow_step_factor,
+            );
+            override_if(
+                &mut args.shadow_aperture,
+                shadow_aperture,
+                c.shadow_aperture_deg,
+            );
+            override_if(&mut args.ao_distance, ao_distance, c.ao_distance_voxels);
             if scale != vct.cones.indirect_scale.unwrap_or(0) {
                 args.indirect_scale = (scale > 0).then_some(scale);
             }
@@ -529,9 +522,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                         .text("samples per pixel"),
                 ),
             );
-            if spp != path.spp {
-                view.args.path.spp = Some(spp);
-            }
+            override_if(&mut view.args.path.spp, spp, path.spp);
             let mut depth = path.max_depth.unwrap_or(0);
             settle(
                 ui.add(egui::Slider::new(&mut depth, 0..=32).text("longest path"))
@@ -550,6 +541,14 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
         GiSettings::Off => {}
     }
     rebuild
+}
+
+/// Sets the command-line option `slot` to `new` where it differs from the value in use,
+/// `old`; an option left unset keeps following the scene file and the defaults.
+fn override_if<T: PartialEq>(slot: &mut Option<T>, new: T, old: T) {
+    if new != old {
+        *slot = Some(new);
+    }
 }
 
 /// The lights, edited live; adding or removing one asks for a rebuild (the shadow atlas
