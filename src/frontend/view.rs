@@ -173,7 +173,9 @@ impl Viewer {
     }
 
     /// Builds the renderer again from the panel's edited command line, keeping the
-    /// scene as it is now (lights moved or added), the camera and the terms. A setting
+    /// scene as it is now (lights moved or added), the camera and what the panel changes
+    /// live (terms, exposure, tonemap, debug view and level where the new technique offers
+    /// the view). A setting
     /// the command line would refuse is reported in the panel and changes nothing.
     fn rebuild(&mut self) -> Result<()> {
         let settings = match self.args.render_settings(&self.renderer.scene.gi) {
@@ -186,7 +188,9 @@ impl Viewer {
         log::info!("rebuilding the renderer for the panel's settings");
         self.renderer.finish()?;
         let camera = self.renderer.camera.clone();
-        let terms = self.renderer.settings.terms;
+        let live = &self.renderer.settings;
+        let (terms, exposure_ev, tonemap) = (live.terms, live.exposure_ev, live.tonemap);
+        let (debug_view, debug_level) = (live.debug_view, live.debug_level);
         match Renderer::new(
             &self.ctx,
             self.renderer.scene.clone(),
@@ -196,7 +200,15 @@ impl Viewer {
         ) {
             Ok(mut renderer) => {
                 renderer.camera = camera;
-                renderer.settings.terms = terms;
+                let offered = renderer.debug_views().contains(&debug_view);
+                let settings = &mut renderer.settings;
+                settings.terms = terms;
+                settings.exposure_ev = exposure_ev;
+                settings.tonemap = tonemap;
+                if offered {
+                    settings.debug_view = debug_view;
+                    settings.debug_level = debug_level;
+                }
                 self.renderer = renderer;
                 self.panel.message = None;
             }
