@@ -188,6 +188,8 @@ gpu_layout! {
         OCTREE_RADIANCE_BRICK = 4;
         /// Octree levels the level table has room for (depth 10 uses 10).
         OCTREE_MAX_LEVELS = 16;
+        /// Specialization constant id of the octree's depth (log2 of the effective grid's resolution), given to every pipeline of voxel cone tracing. As a uniform it would be inlined by lavapipe (Mesa 22.3 `update_inline_shader_state`): a pipeline whose loops it bounds is compiled anew at every bind, and the old code is never freed (1.25 MiB per frame of the octree's voxel bounce).
+        SPEC_OCTREE_DEPTH = 0;
         /// Workgroup size of the passes over fragments and over a level's nodes.
         OCTREE_GROUP_SIZE = 64;
         /// Workgroups along y of a dispatch over an update list: the border transfer, filter and spread passes share each node's work (texels, children, neighbours) among them, so that a short list still fills the GPU (1 on a CPU driver, where a workgroup costs more than the work it shares).

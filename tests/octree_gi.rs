@@ -140,3 +140,36 @@ fn octree_node_view_draws_nodes() {
     assert!(covered > pixels.len() * 3 / 4);
     assert!(colours.len() > 50);
 }
+
+/// Frames of the octree do not grow the process's memory. On lavapipe (Mesa 22.3) a
+/// pipeline whose loops were bounded by a uniform was compiled anew at each bind, its old
+/// code never freed: the octree's voxel bounce grew resident memory by 1.2 MiB per frame
+/// (47.7 MiB over these 40 frames at 32x32, with validation; 0.1 MiB since the octree's
+/// depth is a specialization constant). Not a timing: resident memory after frame 1 and
+/// after the last, from `bench --json`.
+#[test]
+fn octree_frames_keep_memory_flat() {
+    let dir = temp_dir("octree_memory");
+    let json = dir.join("bench.json");
+    let output = voxcone(&[
+        "bench",
+        "--gi",
+        "octree",
+        "--frames",
+        "40",
+        "--warmup",
+        "0",
+        "--size",
+        "32x32",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    common::assert_clean(&output);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let samples = report["rss_mib"].as_array().unwrap();
+    let at = |i: usize| samples[i][1].as_f64().unwrap();
+    let (first, last) = (at(0), at(samples.len() - 1));
+    eprintln!("resident memory: {first:.2} MiB after frame 1, {last:.2} MiB after frame 40");
+    assert!(last - first < 8.0, "grew {:.1} MiB", last - first);
+}

@@ -48,6 +48,7 @@ impl CompositePass {
                 cull: vk::CullModeFlags::NONE,
                 dynamic_depth_bias: false,
                 depth_clamp: false,
+                constants: &[],
             },
         )?;
         Ok(Self {

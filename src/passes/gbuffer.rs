@@ -109,6 +109,7 @@ impl GBufferPass {
                     cull: vk::CullModeFlags::NONE,
                     dynamic_depth_bias: false,
                     depth_clamp: false,
+                    constants: &[],
                 },
             )
         };

@@ -374,6 +374,7 @@ impl ShadowPass {
                 cull: vk::CullModeFlags::NONE,
                 dynamic_depth_bias: true,
                 depth_clamp: ctx.features.depth_clamp,
+                constants: &[],
             },
         )?;
         Ok(Self {

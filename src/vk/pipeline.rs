@@ -43,6 +43,18 @@ fn pipeline_layout(
     Ok(unsafe { ctx.device.create_pipeline_layout(&info, None) }?)
 }
 
+/// Map entries for specialization constants: value i is `constant_id = i`. A shader
+/// without such an id ignores its entry (Vulkan spec, VkSpecializationMapEntry).
+fn specialization_entries(constants: &[u32]) -> Vec<vk::SpecializationMapEntry> {
+    (0..constants.len() as u32)
+        .map(|id| vk::SpecializationMapEntry {
+            constant_id: id,
+            offset: id * 4,
+            size: 4,
+        })
+        .collect()
+}
+
 impl Pipeline {
     pub fn compute(
         ctx: &Arc<Context>,
@@ -51,6 +63,22 @@ impl Pipeline {
         set_layouts: &[vk::DescriptorSetLayout],
         push_constant_bytes: u32,
     ) -> Result<Self> {
+        Self::compute_specialized(ctx, name, spirv, set_layouts, push_constant_bytes, &[])
+    }
+
+    /// A compute pipeline whose specialization constant i is `constants[i]`.
+    pub fn compute_specialized(
+        ctx: &Arc<Context>,
+        name: &str,
+        spirv: &[u8],
+        set_layouts: &[vk::DescriptorSetLayout],
+        push_constant_bytes: u32,
+        constants: &[u32],
+    ) -> Result<Self> {
+        let entries = specialization_entries(constants);
+        let specialization = vk::SpecializationInfo::default()
+            .map_entries(&entries)
+            .data(bytemuck::cast_slice(constants));
         let module = shader_module(ctx, spirv, name)?;
         let layout = pipeline_layout(
             ctx,
@@ -61,7 +89,8 @@ impl Pipeline {
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
-            .name(c"main");
+            .name(c"main")
+            .specialization_info(&specialization);
         let info = [vk::ComputePipelineCreateInfo::default()
             .stage(stage)
             .layout(layout)];
@@ -199,6 +228,8 @@ pub struct GraphicsDesc<'a> {
     /// Depth bias set per draw with `vkCmdSetDepthBias` (shadow maps).
     pub dynamic_depth_bias: bool,
     pub depth_clamp: bool,
+    /// Specialization constant i of every stage is `constants[i]`.
+    pub constants: &'a [u32],
 }
 
 impl Pipeline {
@@ -214,16 +245,22 @@ impl Pipeline {
             .fragment
             .map(|f| shader_module(ctx, f, desc.name))
             .transpose()?;
+        let entries = specialization_entries(desc.constants);
+        let specialization = vk::SpecializationInfo::default()
+            .map_entries(&entries)
+            .data(bytemuck::cast_slice(desc.constants));
         let mut stages = vec![vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::VERTEX)
             .module(vertex)
-            .name(c"main")];
+            .name(c"main")
+            .specialization_info(&specialization)];
         if let Some(geometry) = geometry {
             stages.push(
                 vk::PipelineShaderStageCreateInfo::default()
                     .stage(vk::ShaderStageFlags::GEOMETRY)
                     .module(geometry)
-                    .name(c"main"),
+                    .name(c"main")
+                    .specialization_info(&specialization),
             );
         }
         if let Some(fragment) = fragment {
@@ -231,7 +268,8 @@ impl Pipeline {
                 vk::PipelineShaderStageCreateInfo::default()
                     .stage(vk::ShaderStageFlags::FRAGMENT)
                     .module(fragment)
-                    .name(c"main"),
+                    .name(c"main")
+                    .specialization_info(&specialization),
             );
         }
         let bindings = [vk::VertexInputBindingDescription {

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
-use super::StoreShaders;
+use super::{PipelineBase, StoreShaders};
 use crate::gpu_layout as layout;
 use crate::vk::{groups_2d, Context, Pipeline};
 
@@ -17,21 +17,11 @@ pub struct ConeTracePass {
 }
 
 impl ConeTracePass {
-    /// `set_layouts` are those of sets 0 to 3; `shaders` are the store's variants.
-    pub fn new(
-        ctx: &Arc<Context>,
-        set_layouts: [vk::DescriptorSetLayout; 4],
-        shaders: &StoreShaders,
-    ) -> Result<Self> {
+    /// `base` makes the pipelines; `shaders` are the store's variants.
+    pub fn new(ctx: &Arc<Context>, base: PipelineBase, shaders: &StoreShaders) -> Result<Self> {
         let trace = [
-            Pipeline::compute(ctx, "cone_trace", shaders.cone_trace, &set_layouts, 0)?,
-            Pipeline::compute(
-                ctx,
-                "cone_trace with AO",
-                shaders.cone_trace_ao,
-                &set_layouts,
-                0,
-            )?,
+            base.compute(ctx, "cone_trace", shaders.cone_trace, 0)?,
+            base.compute(ctx, "cone_trace with AO", shaders.cone_trace_ao, 0)?,
         ];
         Ok(Self { trace })
     }

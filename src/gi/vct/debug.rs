@@ -7,7 +7,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
-use super::StoreShaders;
+use super::{PipelineBase, StoreShaders};
 use crate::gpu_layout as layout;
 use crate::vk::{groups_2d, Context, Pipeline};
 
@@ -16,14 +16,10 @@ pub struct VoxelViewPass {
 }
 
 impl VoxelViewPass {
-    /// `set_layouts` are those of sets 0 to 3; `shaders` are the store's variants (the
+    /// `base` makes the pipelines; `shaders` are the store's variants (the
     /// octree's looks the voxels up in the octree, and draws its nodes).
-    pub fn new(
-        ctx: &Arc<Context>,
-        set_layouts: [vk::DescriptorSetLayout; 4],
-        shaders: &StoreShaders,
-    ) -> Result<Self> {
-        let pipeline = Pipeline::compute(ctx, "voxel_view", shaders.voxel_view, &set_layouts, 0)?;
+    pub fn new(ctx: &Arc<Context>, base: PipelineBase, shaders: &StoreShaders) -> Result<Self> {
+        let pipeline = base.compute(ctx, "voxel_view", shaders.voxel_view, 0)?;
         Ok(Self { pipeline })
     }
 

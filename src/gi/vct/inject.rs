@@ -5,7 +5,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
-use super::StoreShaders;
+use super::{PipelineBase, StoreShaders};
 use crate::gpu_layout::{self as layout, InjectPush};
 use crate::vk::{Context, Pipeline};
 
@@ -15,15 +15,11 @@ pub struct InjectPass {
 }
 
 impl InjectPass {
-    /// `set_layouts` are those of sets 0 to 3; `shaders` are the store's variants.
-    pub fn new(
-        ctx: &Arc<Context>,
-        set_layouts: [vk::DescriptorSetLayout; 4],
-        shaders: &StoreShaders,
-    ) -> Result<Self> {
+    /// `base` makes the pipelines; `shaders` are the store's variants.
+    pub fn new(ctx: &Arc<Context>, base: PipelineBase, shaders: &StoreShaders) -> Result<Self> {
         let push = std::mem::size_of::<InjectPush>() as u32;
-        let pipeline = Pipeline::compute(ctx, "inject", shaders.inject, &set_layouts, push)?;
-        let bounce = Pipeline::compute(ctx, "bounce", shaders.bounce, &set_layouts, 0)?;
+        let pipeline = base.compute(ctx, "inject", shaders.inject, push)?;
+        let bounce = base.compute(ctx, "bounce", shaders.bounce, 0)?;
         Ok(Self { pipeline, bounce })
     }
 

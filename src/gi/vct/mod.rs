@@ -40,7 +40,7 @@ use crate::scene::Scene;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
     compute_to_compute, memory_barrier, sampler_info, Binding, Buffer, Context, DescriptorSets,
-    GpuTimer, Image, Sampler, SetWriter,
+    GpuTimer, Image, Pipeline, Sampler, SetWriter,
 };
 
 /// The shader stages that read the cone tracer's set: the voxelizers' and every compute
@@ -85,8 +85,8 @@ pub trait VoxelStore: Sized + 'static {
     /// The store's own set-3 bindings, after the shared ones.
     fn bindings() -> Vec<Binding>;
 
-    /// Creates the store over `grid` and writes its resources into `set`. `layouts` are
-    /// those of sets 0 to 3, `linear` the sampler of the radiance the cones sample;
+    /// Creates the store over `grid` and writes its resources into `set`. `base` makes
+    /// its pipelines, `linear` the sampler of the radiance the cones sample;
     /// `frames_in_flight` frames may be recorded before the first is done.
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -95,7 +95,7 @@ pub trait VoxelStore: Sized + 'static {
         settings: &VctSettings,
         grid: Grid,
         set: vk::DescriptorSet,
-        layouts: [vk::DescriptorSetLayout; 4],
+        base: PipelineBase,
         linear: vk::Sampler,
         frames_in_flight: usize,
     ) -> Result<Self>;
@@ -233,6 +233,39 @@ pub(crate) fn bind_cone_samples<'a>(
         )
 }
 
+/// What every pipeline of voxel cone tracing is made with: the layouts of sets 0 to 3,
+/// and the specialization constants (`SPEC_OCTREE_DEPTH`, which the dense grid's shaders
+/// do not declare and so ignore).
+#[derive(Clone, Copy)]
+pub struct PipelineBase {
+    pub sets: [vk::DescriptorSetLayout; 4],
+    constants: [u32; 1],
+}
+
+impl PipelineBase {
+    pub fn compute(
+        &self,
+        ctx: &Arc<Context>,
+        name: &str,
+        spirv: &[u8],
+        push_constant_bytes: u32,
+    ) -> Result<Pipeline> {
+        Pipeline::compute_specialized(
+            ctx,
+            name,
+            spirv,
+            &self.sets,
+            push_constant_bytes,
+            &self.constants,
+        )
+    }
+
+    /// For a graphics pipeline's `GraphicsDesc::constants`.
+    pub fn constants(&self) -> &[u32] {
+        &self.constants
+    }
+}
+
 /// Creates the cone tracer with the store `settings` asks for.
 pub fn create(inputs: &Inputs, settings: &VctSettings) -> Result<Box<dyn Technique>> {
     Ok(match settings.store {
@@ -302,14 +335,17 @@ impl<S: VoxelStore> ConeTracing<S> {
             // and filtering towards a border would thin every wall there.
             &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::CLAMP_TO_EDGE),
         )?;
-        let layouts = [set_layouts[0], set_layouts[1], set_layouts[2], sets.layout];
+        let base = PipelineBase {
+            sets: [set_layouts[0], set_layouts[1], set_layouts[2], sets.layout],
+            constants: [resolution.ilog2()],
+        };
         let store = S::new(
             ctx,
             scene,
             settings,
             grid,
             set,
-            layouts,
+            base,
             linear.raw,
             frames_in_flight,
         )?;
@@ -348,15 +384,15 @@ impl<S: VoxelStore> ConeTracing<S> {
             .apply();
         Ok(Self {
             store,
-            inject: inject::InjectPass::new(ctx, layouts, &S::SHADERS)?,
+            inject: inject::InjectPass::new(ctx, base, &S::SHADERS)?,
             bounces: cones.bounces.max(1),
             accumulate_bounces: cones.accumulate_bounces && cones.bounces > 1,
             history: false,
             lighting: None,
             shadow_cones: settings.shadow_cones,
             indirect_scale: cones.indirect_scale,
-            cone_trace: cone_trace::ConeTracePass::new(ctx, layouts, &S::SHADERS)?,
-            voxel_view: debug::VoxelViewPass::new(ctx, layouts, &S::SHADERS)?,
+            cone_trace: cone_trace::ConeTracePass::new(ctx, base, &S::SHADERS)?,
+            voxel_view: debug::VoxelViewPass::new(ctx, base, &S::SHADERS)?,
             set,
             _sets: sets,
             _uniforms: uniforms,

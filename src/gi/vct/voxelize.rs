@@ -9,7 +9,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
-use super::Grid;
+use super::{Grid, PipelineBase};
 use crate::gpu_layout::{self as layout, DrawPush};
 use crate::scene::Mesh;
 use crate::scene_gpu::{SceneDraw, VERTEX_ATTRIBUTES};
@@ -66,15 +66,15 @@ impl VoxelizePass {
     };
 
     /// `fragment` and `compute` are the SPIR-V of the two voxelizers' shaders that store
-    /// what each covered voxel receives (`glsl/gi/vct/voxelize/coverage.glsl`); `set_layouts`
-    /// are those of sets 0 to 3.
+    /// what each covered voxel receives (`glsl/gi/vct/voxelize/coverage.glsl`); `base` makes
+    /// the pipeline.
     pub fn new(
         ctx: &Arc<Context>,
         name: &str,
         voxelizer: Voxelizer,
         fragment: &[u8],
         compute: &[u8],
-        set_layouts: [vk::DescriptorSetLayout; 4],
+        base: PipelineBase,
     ) -> Result<Self> {
         let push_bytes = std::mem::size_of::<DrawPush>() as u32;
         let pipeline = match voxelizer.on(ctx) {
@@ -87,7 +87,7 @@ impl VoxelizePass {
                     fragment: Some(fragment),
                     vertex_stride: std::mem::size_of::<crate::scene::Vertex>() as u32,
                     attributes: &VERTEX_ATTRIBUTES,
-                    set_layouts: &set_layouts,
+                    set_layouts: &base.sets,
                     push_constant_bytes: push_bytes,
                     color_formats: &[],
                     depth_format: None,
@@ -95,9 +95,10 @@ impl VoxelizePass {
                     cull: vk::CullModeFlags::NONE,
                     dynamic_depth_bias: false,
                     depth_clamp: false,
+                    constants: base.constants(),
                 },
             )?,
-            Voxelizer::Compute => Pipeline::compute(ctx, name, compute, &set_layouts, push_bytes)?,
+            Voxelizer::Compute => base.compute(ctx, name, compute, push_bytes)?,
         };
         Ok(Self { pipeline })
     }

@@ -56,8 +56,11 @@ layout(set = SET_GI, binding = BINDING_OCTREE_UPDATES, std430) buffer UpdatesBlo
 // Mask of a child entry's tile index.
 #define OCTREE_CHILD_MASK (~OCTREE_SUBDIVIDE)
 
+// findMSB(vct.resolution), fixed when the pipeline is made (see SPEC_OCTREE_DEPTH).
+layout(constant_id = SPEC_OCTREE_DEPTH) const uint OCTREE_DEPTH = 0u;
+
 uint octree_depth() {
-    return uint(findMSB(vct.resolution));
+    return OCTREE_DEPTH;
 }
 
 uint pack_coord(uvec3 c) {

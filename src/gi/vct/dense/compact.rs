@@ -8,6 +8,7 @@ use anyhow::Result;
 use ash::vk;
 
 use crate::gi::vct::voxel_list::reset_voxel_list;
+use crate::gi::vct::PipelineBase;
 use crate::gpu_layout::{self as layout, VoxelListHeader};
 use crate::vk::{groups_3d, memory_barrier, Buffer, Context, Pipeline};
 
@@ -18,17 +19,12 @@ pub struct CompactPass {
 }
 
 impl CompactPass {
-    /// `set_layouts` are those of sets 0 to 3; `n` is the grid resolution.
-    pub fn new(
-        ctx: &Arc<Context>,
-        set_layouts: [vk::DescriptorSetLayout; 4],
-        n: u32,
-    ) -> Result<Self> {
-        let pipeline = Pipeline::compute(
+    /// `base` makes the pipeline; `n` is the grid resolution.
+    pub fn new(ctx: &Arc<Context>, base: PipelineBase, n: u32) -> Result<Self> {
+        let pipeline = base.compute(
             ctx,
             "compact",
             crate::vk::shaders::GI_VCT_DENSE_COMPACT_COMP,
-            &set_layouts,
             0,
         )?;
         let header = std::mem::size_of::<VoxelListHeader>() as u64;

@@ -15,8 +15,8 @@ use ash::vk;
 
 use super::voxelize::{self, Meshes, VoxelizePass};
 use super::{
-    bind_cone_samples, directional_levels, Grid, Preparation, StoreShaders, VctSettings,
-    VoxelStore, Voxels,
+    bind_cone_samples, directional_levels, Grid, PipelineBase, Preparation, StoreShaders,
+    VctSettings, VoxelStore, Voxels,
 };
 use crate::gi::DebugView;
 use crate::gpu_layout::{self as layout, InjectPush};
@@ -181,7 +181,7 @@ impl VoxelStore for Dense {
         settings: &VctSettings,
         grid: Grid,
         set: vk::DescriptorSet,
-        layouts: [vk::DescriptorSetLayout; 4],
+        base: PipelineBase,
         linear: vk::Sampler,
         _frames_in_flight: usize,
     ) -> Result<Self> {
@@ -225,7 +225,7 @@ impl VoxelStore for Dense {
             Ok(())
         })?;
         to_compute_write(ctx, "gi volume layouts", &[&volumes.directional])?;
-        let compact = compact::CompactPass::new(ctx, layouts, resolution)?;
+        let compact = compact::CompactPass::new(ctx, base, resolution)?;
         SetWriter::new(ctx, set)
             .buffer(
                 layout::BINDING_VCT_VOXEL_LIST,
@@ -241,9 +241,9 @@ impl VoxelStore for Dense {
                 voxelizer,
                 crate::vk::shaders::GI_VCT_VOXELIZE_VOXELIZE_FRAG,
                 crate::vk::shaders::GI_VCT_VOXELIZE_VOXELIZE_COMP,
-                layouts,
+                base,
             )?,
-            filter: filter::FilterPass::new(ctx, [layouts[0], layouts[1]], &volumes)?,
+            filter: filter::FilterPass::new(ctx, [base.sets[0], base.sets[1]], &volumes)?,
             compact,
             volumes,
             full_update,

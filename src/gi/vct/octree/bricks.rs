@@ -19,6 +19,7 @@ use anyhow::Result;
 use ash::vk;
 
 use super::nodes::{compute_to_indirect, dispatch_for_level, push_and_dispatch, timed_pass, Over};
+use crate::gi::vct::PipelineBase;
 use crate::gpu_layout::{self as layout, OctreePush, OctreeUpdateList};
 use crate::vk::{stage_barrier, Context, GpuTimer, Pipeline};
 
@@ -58,10 +59,9 @@ pub struct BrickPasses {
 }
 
 impl BrickPasses {
-    /// `set_layouts` are those of sets 0, 1 and 2.
-    pub fn new(ctx: &Arc<Context>, set_layouts: [vk::DescriptorSetLayout; 4]) -> Result<Self> {
+    pub fn new(ctx: &Arc<Context>, base: PipelineBase) -> Result<Self> {
         let push = std::mem::size_of::<OctreePush>() as u32;
-        let pipeline = |name, spirv| Pipeline::compute(ctx, name, spirv, &set_layouts, push);
+        let pipeline = |name, spirv| base.compute(ctx, name, spirv, push);
         use crate::vk::shaders as s;
         Ok(Self {
             fill: pipeline("octree fill", s::GI_VCT_OCTREE_BRICKS_FILL_COMP)?,

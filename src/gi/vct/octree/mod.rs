@@ -25,7 +25,9 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use super::voxelize::VoxelizePass;
-use super::{Grid, Preparation, Store, StoreShaders, VctSettings, VoxelStore, Voxels};
+use super::{
+    Grid, PipelineBase, Preparation, Store, StoreShaders, VctSettings, VoxelStore, Voxels,
+};
 use crate::gi::DebugView;
 use crate::gpu_layout::{self as layout, InjectPush, OctreeCounters, OctreeLevel};
 use crate::scene::{Aabb, Scene};
@@ -182,7 +184,7 @@ impl VoxelStore for Octree {
         settings: &VctSettings,
         grid: Grid,
         set: vk::DescriptorSet,
-        layouts: [vk::DescriptorSetLayout; 4],
+        base: PipelineBase,
         linear: vk::Sampler,
         frames_in_flight: usize,
     ) -> Result<Self> {
@@ -241,15 +243,14 @@ impl VoxelStore for Octree {
                 voxelizer,
                 crate::vk::shaders::GI_VCT_OCTREE_FRAGMENTS_FRAGMENTS_FRAG,
                 crate::vk::shaders::GI_VCT_VOXELIZE_VOXELIZE_COMP_OCTREE,
-                layouts,
+                base,
             )?,
-            nodes: nodes::NodePasses::new(ctx, layouts)?,
-            bricks: bricks::BrickPasses::new(ctx, layouts)?,
-            bounce_gate: Pipeline::compute(
+            nodes: nodes::NodePasses::new(ctx, base)?,
+            bricks: bricks::BrickPasses::new(ctx, base)?,
+            bounce_gate: base.compute(
                 ctx,
                 "octree bounce dispatch",
                 crate::vk::shaders::GI_VCT_OCTREE_BRICKS_BOUNCE_DISPATCH_COMP,
-                &layouts,
                 0,
             )?,
             report: None,

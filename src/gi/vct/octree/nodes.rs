@@ -11,6 +11,7 @@ use std::sync::Arc;
 use anyhow::Result;
 use ash::vk;
 
+use crate::gi::vct::PipelineBase;
 use crate::gpu_layout::{self as layout, OctreeCounters, OctreeLevel, OctreePush};
 use crate::vk::{compute_to_compute, memory_barrier, Context, GpuTimer, Pipeline};
 
@@ -123,10 +124,9 @@ pub(super) fn compute_to_indirect(ctx: &Context, cmd: vk::CommandBuffer) {
 }
 
 impl NodePasses {
-    /// `set_layouts` are those of sets 0, 1 and 2.
-    pub fn new(ctx: &Arc<Context>, set_layouts: [vk::DescriptorSetLayout; 4]) -> Result<Self> {
+    pub fn new(ctx: &Arc<Context>, base: PipelineBase) -> Result<Self> {
         let push = std::mem::size_of::<OctreePush>() as u32;
-        let pipeline = |name, spirv| Pipeline::compute(ctx, name, spirv, &set_layouts, push);
+        let pipeline = |name, spirv| base.compute(ctx, name, spirv, push);
         use crate::vk::shaders as s;
         Ok(Self {
             flag: pipeline("octree flag", s::GI_VCT_OCTREE_NODES_FLAG_COMP)?,
