@@ -243,6 +243,20 @@ pub struct PipelineBase {
 }
 
 impl PipelineBase {
+    /// For the cone tracer over `grid`, whose store's set 3 has the layout `store_set`.
+    fn new(
+        set_layouts: &[vk::DescriptorSetLayout; 3],
+        store_set: vk::DescriptorSetLayout,
+        grid: &Grid,
+    ) -> Self {
+        let mut constants = [0; 1];
+        constants[layout::SPEC_OCTREE_DEPTH as usize] = grid.resolution.ilog2();
+        Self {
+            sets: [set_layouts[0], set_layouts[1], set_layouts[2], store_set],
+            constants,
+        }
+    }
+
     pub fn compute(
         &self,
         ctx: &Arc<Context>,
@@ -335,10 +349,7 @@ impl<S: VoxelStore> ConeTracing<S> {
             // and filtering towards a border would thin every wall there.
             &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::CLAMP_TO_EDGE),
         )?;
-        let base = PipelineBase {
-            sets: [set_layouts[0], set_layouts[1], set_layouts[2], sets.layout],
-            constants: [resolution.ilog2()],
-        };
+        let base = PipelineBase::new(&set_layouts, sets.layout, &grid);
         let store = S::new(
             ctx,
             scene,
