@@ -6,6 +6,7 @@ use anyhow::{anyhow, bail, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::gi::path::cli::PathArgs;
+use crate::gi::probes::cli::ProbeArgs;
 use crate::gi::vct::cli::VctArgs;
 use crate::gi::{DebugView, GiSettings};
 use crate::passes::shadow::ShadowResolution;
@@ -33,6 +34,9 @@ pub enum Command {
     Bench(BenchArgs),
     /// Compare a test image with a reference: LDR-FLIP and relative MSE.
     Compare(CompareArgs),
+    /// Precompute the irradiance probes' data for a scene (lightmap atlas, receivers,
+    /// probes) and report what it made.
+    Bake(BakeArgs),
 }
 
 /// Which global-illumination technique runs.
@@ -202,6 +206,18 @@ pub struct BenchArgs {
     /// Draw the viewer's settings panel over every frame, as the timed pass `ui`.
     #[arg(long)]
     pub ui: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct BakeArgs {
+    /// Scene: a .toml scene file, a reference .scene.json, a bare .obj or a glTF scene
+    /// (default: the built-in Cornell box).
+    pub scene: Option<PathBuf>,
+    #[command(flatten)]
+    pub probes: ProbeArgs,
+    /// Also write the report as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]

@@ -205,6 +205,28 @@ fn move_light_without_a_light() {
     );
 }
 
+#[test]
+fn bad_bake_settings_and_scenes() {
+    for (option, value) in [
+        ("--probes", "0"),
+        ("--overlaps", "65"),
+        ("--lightmap-size", "8"),
+    ] {
+        assert_fails_naming(&["bake", option, value], &[option, value]);
+    }
+    let dir = temp_dir("bake");
+    // One triangle: the placement grid spans its flat bounds, and it lies in every cell.
+    write(&dir, "tri.obj", TRIANGLE);
+    let scene = scene_for(&dir, "tri.obj");
+    assert_fails_naming(&["bake", &scene], &["no free space", "probes"]);
+    let moving = write(
+        &dir,
+        "moving.toml",
+        "[[mesh]]\npath = \"tri.obj\"\nanimate = { kind = \"spin\", axis = [0, 1, 0], deg_per_s = 45.0 }\n",
+    );
+    assert_fails_naming(&["bake", &moving], &["no static triangles"]);
+}
+
 /// How a corpus case must end.
 enum Outcome {
     /// A non-zero exit whose error names each of these.

@@ -13,6 +13,7 @@
 //! reference ([`path`]).
 
 pub mod path;
+pub mod probes;
 pub mod screen;
 pub mod vct;
 

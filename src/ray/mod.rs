@@ -11,6 +11,7 @@
 
 mod atlas;
 mod bvh;
+pub mod host;
 pub mod query;
 #[cfg(test)]
 mod tests;

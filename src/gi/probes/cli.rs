@@ -1,0 +1,51 @@
+//! The irradiance probes' command-line options.
+
+use anyhow::{bail, Result};
+use clap::Args;
+
+use super::BakeSettings;
+
+#[derive(Args, Debug, Clone, Default)]
+pub struct ProbeArgs {
+    /// Width and height of the lightmap page the receivers' atlas is fitted into, 16 to
+    /// 16384 texels: one receiver per covered texel [default: 512].
+    #[arg(long)]
+    pub lightmap_size: Option<u32>,
+    /// The desired number of probes: their spacing is that of this many cubes filling the
+    /// static scene's bounding box (Sedláček's ρ_p); fewer where free space near surfaces
+    /// is short, 1 to 65536 [default: 256].
+    #[arg(long)]
+    pub probes: Option<u32>,
+    /// The most probes supporting each receiver, which also sets the probes' radius
+    /// (Sedláček's N_OVERLAPS), 1 to 64 [default: 10].
+    #[arg(long)]
+    pub overlaps: Option<u32>,
+}
+
+impl ProbeArgs {
+    /// The bake's settings: the command line over the defaults.
+    pub fn settings(&self) -> Result<BakeSettings> {
+        let d = BakeSettings::default();
+        let settings = BakeSettings {
+            lightmap_size: self.lightmap_size.unwrap_or(d.lightmap_size),
+            probes: self.probes.unwrap_or(d.probes),
+            overlaps: self.overlaps.unwrap_or(d.overlaps),
+        };
+        if !(16..=16384).contains(&settings.lightmap_size) {
+            bail!(
+                "--lightmap-size {}: the lightmap must be 16 to 16384 texels wide",
+                settings.lightmap_size
+            );
+        }
+        if !(1..=65536).contains(&settings.probes) {
+            bail!("--probes {}: give 1 to 65536 probes", settings.probes);
+        }
+        if !(1..=64).contains(&settings.overlaps) {
+            bail!(
+                "--overlaps {}: each receiver takes 1 to 64 probes",
+                settings.overlaps
+            );
+        }
+        Ok(settings)
+    }
+}
