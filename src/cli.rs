@@ -218,6 +218,17 @@ pub struct BakeArgs {
     /// Also write the report as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Write the lightmap's irradiance from the emitters and the sky here (.exr, or .png
+    /// clamped and sRGB-encoded).
+    #[arg(long)]
+    pub preview: Option<PathBuf>,
+    /// Enable the Vulkan validation layer; any message makes the command fail. Also on
+    /// when VOXCONE_VALIDATION=1.
+    #[arg(long)]
+    pub validation: bool,
+    /// Use the first Vulkan device whose name contains this text.
+    #[arg(long)]
+    pub device: Option<String>,
 }
 
 #[derive(Args, Debug)]

@@ -21,19 +21,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             frontend::bench::run(&args)?;
         }
         Some(Command::Bake(args)) => {
-            let path = args
-                .scene
-                .clone()
-                .unwrap_or_else(voxcone::cli::default_scene);
-            let scene = voxcone::scene::Scene::load(&path, &Default::default())
-                .map_err(|e| e.context(format!("loading scene {}", path.display())))?;
-            let report = voxcone::gi::probes::bake(&scene, &args.probes.settings()?)?;
-            let text = serde_json::to_string_pretty(&report)?;
-            println!("{text}");
-            if let Some(path) = &args.json {
-                std::fs::write(path, &text)
-                    .map_err(|e| anyhow::anyhow!("writing {}: {e}", path.display()))?;
-            }
+            frontend::bake::run(&args)?;
         }
         Some(Command::Compare(args)) => {
             let options = voxcone::compare::CompareOptions {

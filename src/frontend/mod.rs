@@ -1,5 +1,6 @@
 //! Thin front ends over the renderer: headless render, window viewer, benchmark.
 
+pub mod bake;
 pub mod bench;
 pub mod render;
 mod ui;

@@ -20,6 +20,18 @@ pub struct ProbeArgs {
     /// (Sedláček's N_OVERLAPS), 1 to 64 [default: 10].
     #[arg(long)]
     pub overlaps: Option<u32>,
+    /// Each probe casts a ray through every texel of an N × N equal-area octahedral map,
+    /// 8 to 256 [default: 64].
+    #[arg(long)]
+    pub probe_side: Option<u32>,
+    /// Hemisphere rays per receiver for its transport coefficients, 1 to 4096
+    /// [default: 64].
+    #[arg(long)]
+    pub receiver_rays: Option<u32>,
+    /// The highest spherical-harmonic band the probes store, 0 to 7: (N + 1)²
+    /// coefficients [default: 3].
+    #[arg(long)]
+    pub sh_order: Option<u32>,
 }
 
 impl ProbeArgs {
@@ -30,6 +42,9 @@ impl ProbeArgs {
             lightmap_size: self.lightmap_size.unwrap_or(d.lightmap_size),
             probes: self.probes.unwrap_or(d.probes),
             overlaps: self.overlaps.unwrap_or(d.overlaps),
+            probe_side: self.probe_side.unwrap_or(d.probe_side),
+            receiver_rays: self.receiver_rays.unwrap_or(d.receiver_rays),
+            sh_order: self.sh_order.unwrap_or(d.sh_order),
         };
         if !(16..=16384).contains(&settings.lightmap_size) {
             bail!(
@@ -44,6 +59,25 @@ impl ProbeArgs {
             bail!(
                 "--overlaps {}: each receiver takes 1 to 64 probes",
                 settings.overlaps
+            );
+        }
+        if !(8..=256).contains(&settings.probe_side) {
+            bail!(
+                "--probe-side {}: each probe's map is 8 to 256 texels wide",
+                settings.probe_side
+            );
+        }
+        if !(1..=4096).contains(&settings.receiver_rays) {
+            bail!(
+                "--receiver-rays {}: give 1 to 4096 rays per receiver",
+                settings.receiver_rays
+            );
+        }
+        if settings.sh_order > super::sh::MAX_ORDER {
+            bail!(
+                "--sh-order {}: the probes store bands 0 to {} at most",
+                settings.sh_order,
+                super::sh::MAX_ORDER
             );
         }
         Ok(settings)

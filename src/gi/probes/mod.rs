@@ -2,26 +2,40 @@
 //! (Silvennoinen & Lehtinen 2017, as Sedláček 2019 implements and extends it).
 //!
 //! The precomputation (`voxcone bake`) so far: the lightmap atlas ([`lightmap`]), its
-//! receivers ([`receivers`]), the probes and their radius ([`placement`]), and the
-//! spherical harmonics the probes will store their radiance in ([`sh`]).
+//! receivers ([`receivers`]), the probes and their radius ([`placement`]), the probes'
+//! and the receivers' rays on the GPU ([`casting`]), the receivers' transport
+//! coefficients ([`transport`]) in spherical harmonics ([`sh`]), and a host twin of the
+//! relight ([`relight`]). The bake sees the static meshes only: the transport assumes
+//! them (Sedláček 2019, 4.1), and moving meshes neither occlude nor bounce light here.
 
+pub mod casting;
 pub mod cli;
 pub mod lightmap;
+pub mod octahedral;
 pub mod placement;
 pub mod receivers;
+pub mod relight;
 pub mod sh;
 #[cfg(test)]
 mod tests;
+pub mod transport;
 
+use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Result;
 use serde::Serialize;
 
+use self::casting::ProbeViews;
 use self::lightmap::Lightmap;
 use self::placement::Probes;
 use self::receivers::Receivers;
+use self::transport::{Transport, TransportSettings};
+use crate::ray::query::RayQueries;
+use crate::ray::{SceneRays, Triangles};
 use crate::scene::Scene;
+use crate::vk::Context;
 
 /// The bake's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,6 +46,12 @@ pub struct BakeSettings {
     pub probes: u32,
     /// N_OVERLAPS: the most probes per receiver.
     pub overlaps: u32,
+    /// Each probe's rays: through the texels of a `probe_side`² equal-area octahedral map.
+    pub probe_side: u32,
+    /// Each receiver's hemisphere rays.
+    pub receiver_rays: u32,
+    /// The highest band of the harmonics: (order + 1)² coefficients.
+    pub sh_order: u32,
 }
 
 impl Default for BakeSettings {
@@ -40,6 +60,9 @@ impl Default for BakeSettings {
             lightmap_size: 512,
             probes: 256,
             overlaps: 10,
+            probe_side: 64,
+            receiver_rays: 64,
+            sh_order: 3,
         }
     }
 }
@@ -66,12 +89,36 @@ pub struct BakeReport {
     /// light: 3.2.3.2).
     pub mean_support: f64,
     pub unsupported_receivers: usize,
+    pub probe_rays: usize,
+    pub receiver_rays: usize,
+    /// The share of the receivers' rays that hit a surface no supporting probe sees
+    /// (their light is lost).
+    pub unseen_hit_share: f64,
+    /// The receivers' transport: probe entries and their coefficients' memory.
+    pub transport_entries: usize,
+    pub transport_mib: f64,
     /// Host milliseconds per phase, in order.
     pub phases_ms: Vec<(String, f64)>,
 }
 
-/// Runs the bake's phases on `scene`.
-pub fn bake(scene: &Scene, settings: &BakeSettings) -> Result<BakeReport> {
+/// The static meshes of `scene`, which the bake's transport assumes.
+pub fn static_scene(scene: &Scene) -> Scene {
+    let mut out = scene.clone();
+    out.meshes.retain(|m| m.animation.is_none());
+    out.triangle_count = out.meshes.iter().map(|m| m.indices.len() / 3).sum();
+    out
+}
+
+/// Runs the bake's phases on the static meshes of `scene`; with `preview`, writes there
+/// the lightmap's irradiance from the emitters and the sky (an EXR of radiance, or a PNG
+/// of it clamped and sRGB-encoded).
+pub fn bake(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    settings: &BakeSettings,
+    preview: Option<&Path>,
+) -> Result<BakeReport> {
+    let scene = &static_scene(scene);
     let mut phases = Vec::new();
     let mut clock = Instant::now();
     let mut lap = |name: &str| {
@@ -91,6 +138,54 @@ pub fn bake(scene: &Scene, settings: &BakeSettings) -> Result<BakeReport> {
         .map(|r| probes.support(r.position, overlaps).len())
         .collect();
     lap("probe support");
+    let rays = SceneRays::new(ctx, scene, 1)?;
+    let mut queries = RayQueries::new(ctx, &rays, 1 << 18)?;
+    let triangles = Triangles::of(scene, 0.0, |_| true);
+    lap("scene rays");
+    let views = ProbeViews::cast(
+        &mut queries,
+        &probes.positions,
+        settings.probe_side as usize,
+    )?;
+    lap("probe rays");
+    let transport = Transport::compute(
+        &mut queries,
+        &triangles,
+        &receivers.list,
+        &probes,
+        &views,
+        &TransportSettings {
+            order: settings.sh_order,
+            rays: settings.receiver_rays as usize,
+            overlaps,
+            offset: 1e-4 * placement::static_bounds(scene).diagonal(),
+        },
+    )?;
+    lap("receiver transport");
+    if let Some(path) = preview {
+        let basis = sh::Basis::new(settings.sh_order);
+        let lambda =
+            relight::emitted_lambda(scene, &triangles, &views, probes.positions.len(), &basis);
+        let mut rgba = vec![0.0f32; (lightmap.width * lightmap.height * 4) as usize];
+        for (i, r) in receivers.list.iter().enumerate() {
+            let e = relight::irradiance(&transport, &lambda, scene.sky, i);
+            let texel = (r.texel[1] * lightmap.width + r.texel[0]) as usize;
+            rgba[texel * 4..texel * 4 + 4].copy_from_slice(&e.extend(1.0).to_array());
+        }
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+        {
+            let srgb: Vec<u8> = rgba
+                .iter()
+                .map(|&x| crate::imageio::srgb8_encode(x))
+                .collect();
+            crate::imageio::write_png(path, lightmap.width, lightmap.height, &srgb)?;
+        } else {
+            crate::imageio::write_exr(path, lightmap.width, lightmap.height, &rgba)?;
+        }
+        lap("preview");
+    }
     let supported = support.iter().filter(|&&n| n > 0).count();
     Ok(BakeReport {
         scene: scene.source.display().to_string(),
@@ -107,6 +202,11 @@ pub fn bake(scene: &Scene, settings: &BakeSettings) -> Result<BakeReport> {
         probe_radius: probes.radius,
         mean_support: support.iter().sum::<usize>() as f64 / support.len().max(1) as f64,
         unsupported_receivers: support.len() - supported,
+        probe_rays: views.hits.len(),
+        receiver_rays: receivers.list.len() * settings.receiver_rays as usize,
+        unseen_hit_share: transport.unseen as f64 / transport.hits.max(1) as f64,
+        transport_entries: transport.probes.len(),
+        transport_mib: (transport.alpha.len() * 4 + transport.probes.len() * 4) as f64 / 1048576.0,
         phases_ms: phases,
     })
 }

@@ -102,6 +102,20 @@ fn surface_point(scene: &Scene, m: usize, t: usize, bary: Vec2) -> Vec3 {
     p(0) * (1.0 - bary.x - bary.y) + p(1) * bary.x + p(2) * bary.y
 }
 
+/// The barycentrics `bary` of a point on an edge of triangle `t` of mesh `m`, moved
+/// `shift` (world units) towards the triangle's centroid, at most halfway there. A border
+/// receiver at the closest point of its chart would lie on the edge, where the chart
+/// meets its neighbour (a room's floor its wall), and half its hemisphere's rays would
+/// leave through the neighbour's plane at distance zero.
+fn inward(scene: &Scene, m: usize, t: usize, bary: Vec2, shift: f32) -> Vec2 {
+    let centroid = Vec2::splat(1.0 / 3.0);
+    let span = surface_point(scene, m, t, bary).distance(surface_point(scene, m, t, centroid));
+    if span <= 0.0 {
+        return bary;
+    }
+    bary.lerp(centroid, (shift / span).min(0.5))
+}
+
 impl Receivers {
     /// Scans every static triangle of `scene` in `lightmap`.
     pub fn place(scene: &Scene, lightmap: &Lightmap) -> Self {
@@ -169,7 +183,12 @@ impl Receivers {
             let mesh = &scene.meshes[c.mesh as usize];
             let t = c.triangle as usize;
             let v = |k: usize| &mesh.vertices[mesh.indices[3 * t + k] as usize];
-            let weights = [1.0 - c.bary.x - c.bary.y, c.bary.x, c.bary.y];
+            let bary = if c.distance > 0.0 {
+                inward(scene, c.mesh as usize, t, c.bary, 0.5 * texel_world)
+            } else {
+                c.bary
+            };
+            let weights = [1.0 - bary.x - bary.y, bary.x, bary.y];
             let normal_matrix = Mat3::from_mat4(mesh.transform).inverse().transpose();
             let corner = |k: usize| mesh.transform.transform_point3(Vec3::from(v(k).position));
             let winding = (corner(1) - corner(0)).cross(corner(2) - corner(0));
@@ -182,7 +201,7 @@ impl Receivers {
             };
             index[i] = list.len() as u32;
             list.push(Receiver {
-                position: surface_point(scene, c.mesh as usize, t, c.bary),
+                position: surface_point(scene, c.mesh as usize, t, bary),
                 normal,
                 material: mesh.material,
                 texel: [(i % w) as u32, (i / w) as u32],

@@ -1,0 +1,87 @@
+//! The bake's ray casting on the GPU (Sedláček 2019, 3.2.3), through the scene ray
+//! caster's batched queries: each probe's rays through the texel centres of its
+//! equal-area octahedral map, and each receiver's cosine-distributed hemisphere rays.
+
+use glam::{Quat, Vec3};
+
+use super::octahedral;
+use crate::gpu_layout::{RayHit, RayQuery, RAY_CLOSEST, RAY_NONE};
+use crate::ray::query::RayQueries;
+use crate::ray::Triangles;
+use anyhow::Result;
+
+/// What the probes see: per probe, a `side` × `side` equal-area octahedral map of closest
+/// hits.
+pub struct ProbeViews {
+    pub side: usize,
+    /// Per probe and texel, the hit (`RAY_NONE`: the sky).
+    pub hits: Vec<RayHit>,
+}
+
+impl ProbeViews {
+    /// Casts every probe's rays.
+    pub fn cast(queries: &mut RayQueries, probes: &[Vec3], side: usize) -> Result<Self> {
+        let texels = side * side;
+        let mut rays = Vec::with_capacity(probes.len() * texels);
+        for p in probes {
+            for i in 0..texels {
+                rays.push(query(*p, octahedral::texel_direction(i, side), 0.0));
+            }
+        }
+        Ok(Self {
+            side,
+            hits: queries.run(&rays)?,
+        })
+    }
+
+    /// How far probe `probe` sees along its texel holding the unit direction `d`
+    /// (infinite where it sees the sky).
+    pub fn depth(&self, probe: usize, d: Vec3) -> f32 {
+        let hit = &self.hits[probe * self.side * self.side + octahedral::texel_of(d, self.side)];
+        if hit.triangle == RAY_NONE {
+            f32::INFINITY
+        } else {
+            hit.t
+        }
+    }
+
+    /// The angular radius of a texel's cone of equal solid angle, 4π / side² = π δ².
+    pub fn texel_radius(&self) -> f32 {
+        2.0 / self.side as f32
+    }
+}
+
+pub fn query(origin: Vec3, dir: Vec3, t_min: f32) -> RayQuery {
+    RayQuery {
+        origin_tmin: origin.extend(t_min).to_array(),
+        direction_tmax: dir.extend(f32::MAX).to_array(),
+        kind: RAY_CLOSEST,
+        ..Default::default()
+    }
+}
+
+/// `count` directions about +Z distributed as cos θ / π: Vogel's spiral, even over the unit
+/// disc, lifted onto the hemisphere (Malley's method).
+pub fn cosine_directions(count: usize) -> Vec<Vec3> {
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    (0..count)
+        .map(|i| {
+            let r = ((i as f32 + 0.5) / count as f32).sqrt();
+            let phi = golden * i as f32;
+            Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - r * r).max(0.0).sqrt())
+        })
+        .collect()
+}
+
+/// The pattern `pattern` turned to the normal `n` and by `spin` radians about it (a
+/// different spin per receiver keeps neighbours' errors apart).
+pub fn oriented(pattern: &[Vec3], n: Vec3, spin: f32) -> impl Iterator<Item = Vec3> + '_ {
+    let turn = Quat::from_rotation_arc(Vec3::Z, n) * Quat::from_rotation_z(spin);
+    pattern.iter().map(move |d| (turn * *d).normalize())
+}
+
+/// The unit geometric normal of triangle `t` of `triangles` (their winding's).
+pub fn triangle_normal(triangles: &Triangles, t: u32) -> Vec3 {
+    let [a, b, c] = triangles.corners[t as usize];
+    (b - a).cross(c - a).normalize_or_zero()
+}
