@@ -4,12 +4,13 @@
 //! The precomputation (`voxcone bake`) so far: the lightmap atlas ([`lightmap`]), its
 //! receivers ([`receivers`]), the probes and their radius ([`placement`]), the probes'
 //! and the receivers' rays on the GPU ([`casting`]), the receivers' transport
-//! coefficients ([`transport`]) in spherical harmonics ([`sh`]), and a host twin of the
-//! relight ([`relight`]). The bake sees the static meshes only: the transport assumes
+//! coefficients ([`transport`]) in spherical harmonics ([`sh`]), their clustered PCA
+//! ([`clusters`]), and a host twin of the relight and the reconstruction ([`relight`]). The bake sees the static meshes only: the transport assumes
 //! them (Sedláček 2019, 4.1), and moving meshes neither occlude nor bounce light here.
 
 pub mod casting;
 pub mod cli;
+pub mod clusters;
 pub mod lightmap;
 pub mod octahedral;
 pub mod placement;
@@ -28,6 +29,7 @@ use anyhow::Result;
 use serde::Serialize;
 
 use self::casting::ProbeViews;
+use self::clusters::{ClusterSettings, Clusters};
 use self::lightmap::Lightmap;
 use self::placement::Probes;
 use self::receivers::Receivers;
@@ -97,6 +99,17 @@ pub struct BakeReport {
     /// The receivers' transport: probe entries and their coefficients' memory.
     pub transport_entries: usize,
     pub transport_mib: f64,
+    /// The clustered PCA: clusters, their mean basis count, the largest truncation
+    /// error of a cluster and that of the whole transport (relative Frobenius norms),
+    /// and the relative L1 error it makes in the receivers' irradiance from the emitters
+    /// and the sky.
+    pub clusters: usize,
+    pub mean_basis: f64,
+    pub largest_cluster_error: f64,
+    pub transport_error: f64,
+    pub irradiance_error: f64,
+    pub cluster_matrices_mib: f64,
+    pub receiver_coordinates_mib: f64,
     /// Host milliseconds per phase, in order.
     pub phases_ms: Vec<(String, f64)>,
 }
@@ -162,13 +175,25 @@ pub fn bake(
         },
     )?;
     lap("receiver transport");
+    let clusters = Clusters::build(&receivers.list, &transport, &ClusterSettings::default());
+    lap("clusters");
+    // The compression's error where it matters, in the receivers' irradiance from the
+    // emitters and the sky: through the clusters against the full transport.
+    let basis = sh::Basis::new(settings.sh_order);
+    let lambda = relight::emitted_lambda(scene, &triangles, &views, probes.positions.len(), &basis);
+    let (mut difference, mut total) = (0.0f64, 0.0f64);
+    let mut compressed = Vec::with_capacity(receivers.list.len());
+    for i in 0..receivers.list.len() {
+        let full = relight::irradiance(&transport, &lambda, scene.sky, i);
+        let e = clusters.irradiance(&transport, &lambda, scene.sky, i);
+        difference += (e - full).abs().element_sum() as f64;
+        total += full.abs().element_sum() as f64;
+        compressed.push(e);
+    }
+    lap("compression check");
     if let Some(path) = preview {
-        let basis = sh::Basis::new(settings.sh_order);
-        let lambda =
-            relight::emitted_lambda(scene, &triangles, &views, probes.positions.len(), &basis);
         let mut rgba = vec![0.0f32; (lightmap.width * lightmap.height * 4) as usize];
-        for (i, r) in receivers.list.iter().enumerate() {
-            let e = relight::irradiance(&transport, &lambda, scene.sky, i);
+        for (r, e) in receivers.list.iter().zip(&compressed) {
             let texel = (r.texel[1] * lightmap.width + r.texel[0]) as usize;
             rgba[texel * 4..texel * 4 + 4].copy_from_slice(&e.extend(1.0).to_array());
         }
@@ -207,6 +232,14 @@ pub fn bake(
         unseen_hit_share: transport.unseen as f64 / transport.hits.max(1) as f64,
         transport_entries: transport.probes.len(),
         transport_mib: (transport.alpha.len() * 4 + transport.probes.len() * 4) as f64 / 1048576.0,
+        clusters: clusters.list.len(),
+        mean_basis: clusters.list.iter().map(|c| c.basis).sum::<usize>() as f64
+            / clusters.list.len().max(1) as f64,
+        largest_cluster_error: clusters.list.iter().map(|c| c.error).fold(0.0, f64::max),
+        transport_error: (clusters.residual / clusters.energy.max(f64::MIN_POSITIVE)).sqrt(),
+        irradiance_error: difference / total.max(f64::MIN_POSITIVE),
+        cluster_matrices_mib: clusters.bytes().0 as f64 / 1048576.0,
+        receiver_coordinates_mib: clusters.bytes().1 as f64 / 1048576.0,
         phases_ms: phases,
     })
 }

@@ -321,14 +321,9 @@ fn furnace_gives_every_receiver_the_walls_irradiance() {
     assert!(worst <= 0.05, "a receiver {:.2} % off π L", 100.0 * worst);
 }
 
-/// The transport coefficients against a brute-force gather: many rays from the receiver
-/// cast on the host (another ray caster), the radiance at each hit reconstructed from
-/// the same probes' harmonics with the same visibility weights. The walls of the built-in
-/// box glow in colours of their own, so the field varies with direction and visibility.
-#[test]
-fn transport_matches_a_brute_force_gather() {
-    let ctx = context();
-    let dir = TempDir::new("probe_alpha");
+/// The built-in box with every material glowing in a colour of its own (and reflecting
+/// nothing): a radiance field that varies with direction and visibility.
+fn glowing_cornell(dir: &TempDir) -> Scene {
     std::fs::copy(
         crate::cli::default_scene().with_file_name("cornell.obj"),
         dir.0.join("cornell.obj"),
@@ -340,8 +335,58 @@ fn transport_matches_a_brute_force_gather() {
          newmtl green\nKd 0 0 0\nKe 0.1 0.8 0.1\nnewmtl block\nKd 0 0 0\nKe 0.2 0.2 0.6\n\
          newmtl light\nKd 0 0 0\nKe 2 2 2\n",
     );
-    let scene = Scene::load(&dir.0.join("cornell.obj"), &LoadOptions::default()).unwrap();
-    let baked = bake_transport(&ctx, &scene, 64, 64, 64);
+    Scene::load(&dir.0.join("cornell.obj"), &LoadOptions::default()).unwrap()
+}
+
+/// The clustered PCA against the transport it compresses: every cluster meets the
+/// projection bound (or is too small to split), and the receivers' irradiance through
+/// the clusters stays within 1 % (relative L1) of the full transport's; with no bound
+/// and every vector kept, within float rounding.
+#[test]
+fn clustered_transport_reconstructs_the_irradiance() {
+    use super::clusters::{ClusterSettings, Clusters};
+    let ctx = context();
+    let dir = TempDir::new("probe_clusters");
+    let baked = bake_transport(&ctx, &glowing_cornell(&dir), 64, 64, 64);
+    let settings = ClusterSettings::default();
+    let exact = ClusterSettings {
+        max_error: 1e-9,
+        max_basis: usize::MAX,
+        ..settings
+    };
+    for (what, settings, bound) in [("default", settings, 0.01), ("every vector", exact, 1e-5)] {
+        let clusters = Clusters::build(&baked.receivers.list, &baked.transport, &settings);
+        let (mut difference, mut total) = (0.0f64, 0.0f64);
+        for r in 0..baked.receivers.list.len() {
+            let full = super::relight::irradiance(&baked.transport, &baked.lambda, Vec3::ZERO, r);
+            let ours = clusters.irradiance(&baked.transport, &baked.lambda, Vec3::ZERO, r);
+            difference += (ours - full).abs().element_sum() as f64;
+            total += full.abs().element_sum() as f64;
+        }
+        let error = difference / total;
+        let basis: usize = clusters.list.iter().map(|c| c.basis).sum();
+        eprintln!(
+            "{what}: {} receivers in {} clusters, {:.1} vectors each, transport error {:.4}, \
+             irradiance error {:.5}",
+            baked.receivers.list.len(),
+            clusters.list.len(),
+            basis as f64 / clusters.list.len() as f64,
+            (clusters.residual / clusters.energy).sqrt(),
+            error
+        );
+        assert!(error <= bound, "{what}: irradiance error {error}");
+    }
+}
+
+/// The transport coefficients against a brute-force gather: many rays from the receiver
+/// cast on the host (another ray caster), the radiance at each hit reconstructed from
+/// the same probes' harmonics with the same visibility weights. The walls of the built-in
+/// box glow in colours of their own, so the field varies with direction and visibility.
+#[test]
+fn transport_matches_a_brute_force_gather() {
+    let ctx = context();
+    let dir = TempDir::new("probe_alpha");
+    let baked = bake_transport(&ctx, &glowing_cornell(&dir), 64, 64, 64);
     let host = crate::ray::host::HostRays::of_static(&baked.scene);
     let basis = super::sh::Basis::new(3);
     let n = basis.count();
