@@ -218,6 +218,14 @@ pub struct BakeArgs {
     /// Also write the report as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// The bake's file [default: in the user's cache folder,
+    /// $XDG_CACHE_HOME/voxcone/bakes or ~/.cache/voxcone/bakes, one per scene file and
+    /// settings].
+    #[arg(long)]
+    pub bake_file: Option<PathBuf>,
+    /// Bake again even where the file is up to date.
+    #[arg(long)]
+    pub force: bool,
     /// Write the lightmap's irradiance from the emitters and the sky here (.exr, or .png
     /// clamped and sRGB-encoded).
     #[arg(long)]

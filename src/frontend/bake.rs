@@ -4,7 +4,8 @@ use anyhow::{Context as _, Result};
 
 use super::check_validation;
 use crate::cli::{default_scene, BakeArgs};
-use crate::gi::probes::{bake, BakeReport};
+use crate::gi::probes::file::default_path;
+use crate::gi::probes::{load_or_bake, BakeReport, Origin};
 use crate::scene::Scene;
 use crate::vk::{Context, ContextOptions};
 
@@ -18,8 +19,23 @@ pub fn run(args: &BakeArgs) -> Result<BakeReport> {
         device: args.device.clone(),
         ..Default::default()
     })?;
-    let report = bake(&ctx, &scene, &settings, args.preview.as_deref())?;
+    let path = match &args.bake_file {
+        Some(p) => p.clone(),
+        None => default_path(&scene, &settings)?,
+    };
+    let bake = load_or_bake(
+        &ctx,
+        &scene,
+        &settings,
+        &path,
+        args.force,
+        args.preview.as_deref(),
+    )?;
     check_validation(&ctx)?;
+    if bake.origin == Origin::Cached && args.preview.is_some() {
+        log::warn!("--preview: the bake was read from its file, not computed; give --force");
+    }
+    let report = bake.report;
     let text = serde_json::to_string_pretty(&report)?;
     println!("{text}");
     if let Some(path) = &args.json {

@@ -11,6 +11,7 @@
 pub mod casting;
 pub mod cli;
 pub mod clusters;
+pub mod file;
 pub mod lightmap;
 pub mod octahedral;
 pub mod placement;
@@ -26,10 +27,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Result;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use self::casting::ProbeViews;
 use self::clusters::{ClusterSettings, Clusters};
+use self::file::{BakeData, Unusable};
 use self::lightmap::Lightmap;
 use self::placement::Probes;
 use self::receivers::Receivers;
@@ -70,7 +72,7 @@ impl Default for BakeSettings {
 }
 
 /// What a bake made, with each phase's host time.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BakeReport {
     pub scene: String,
     pub lightmap: [u32; 2],
@@ -122,15 +124,81 @@ pub fn static_scene(scene: &Scene) -> Scene {
     out
 }
 
+/// How a bake came about.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Origin {
+    /// Read from its file.
+    Cached,
+    /// Computed: there was no file, or (with the reason) it could not be used, or the
+    /// caller asked for a fresh bake.
+    Computed(Option<String>),
+}
+
+/// A bake, its report and where it came from.
+pub struct Bake {
+    pub data: BakeData,
+    pub report: BakeReport,
+    pub origin: Origin,
+}
+
+/// The bake of `scene` with `settings` from the file at `path` where it is whole and
+/// made from the same static meshes and settings, else computed and written there
+/// (also when `force`). `preview`: see [`compute`].
+pub fn load_or_bake(
+    ctx: &Arc<Context>,
+    scene: &Scene,
+    settings: &BakeSettings,
+    path: &Path,
+    force: bool,
+    preview: Option<&Path>,
+) -> Result<Bake> {
+    let key = file::content_key(scene, settings);
+    let reason = if force {
+        None
+    } else {
+        match BakeData::read(path, key) {
+            Ok(data) => {
+                let report = serde_json::from_str(&data.report)
+                    .map_err(|e| anyhow::anyhow!("the bake {}'s report: {e}", path.display()))?;
+                log::info!("bake {} is up to date", path.display());
+                return Ok(Bake {
+                    data,
+                    report,
+                    origin: Origin::Cached,
+                });
+            }
+            Err(Unusable::Missing) => None,
+            Err(Unusable::Stale(why) | Unusable::Corrupt(why)) => {
+                log::warn!("bake {}: {why}; baking again", path.display());
+                Some(why)
+            }
+        }
+    };
+    let (data, report) = compute(ctx, scene, settings, preview)?;
+    let start = Instant::now();
+    data.write(path, key)?;
+    log::info!(
+        "wrote bake {} ({:.1} MiB, {:.2} s)",
+        path.display(),
+        std::fs::metadata(path).map(|m| m.len()).unwrap_or(0) as f64 / 1048576.0,
+        start.elapsed().as_secs_f64()
+    );
+    Ok(Bake {
+        data,
+        report,
+        origin: Origin::Computed(reason),
+    })
+}
+
 /// Runs the bake's phases on the static meshes of `scene`; with `preview`, writes there
 /// the lightmap's irradiance from the emitters and the sky (an EXR of radiance, or a PNG
 /// of it clamped and sRGB-encoded).
-pub fn bake(
+pub fn compute(
     ctx: &Arc<Context>,
     scene: &Scene,
     settings: &BakeSettings,
     preview: Option<&Path>,
-) -> Result<BakeReport> {
+) -> Result<(BakeData, BakeReport)> {
     let scene = &static_scene(scene);
     let mut phases = Vec::new();
     let mut clock = Instant::now();
@@ -212,7 +280,7 @@ pub fn bake(
         lap("preview");
     }
     let supported = support.iter().filter(|&&n| n > 0).count();
-    Ok(BakeReport {
+    let report = BakeReport {
         scene: scene.source.display().to_string(),
         lightmap: [lightmap.width, lightmap.height],
         texels_per_unit: lightmap.texels_per_unit,
@@ -241,5 +309,47 @@ pub fn bake(
         cluster_matrices_mib: clusters.bytes().0 as f64 / 1048576.0,
         receiver_coordinates_mib: clusters.bytes().1 as f64 / 1048576.0,
         phases_ms: phases,
-    })
+    };
+    let mut mesh_corners = vec![0u32];
+    for c in &lightmap.corners {
+        mesh_corners.push(mesh_corners.last().copied().unwrap_or(0) + c.len() as u32);
+    }
+    let mut cluster_probe_starts = vec![0u32];
+    let mut cluster_projection_starts = vec![0u32];
+    for c in &clusters.list {
+        cluster_probe_starts
+            .push(cluster_probe_starts.last().copied().unwrap_or(0) + c.probes.len() as u32);
+        cluster_projection_starts.push(
+            cluster_projection_starts.last().copied().unwrap_or(0) + c.projection.len() as u32,
+        );
+    }
+    let data = BakeData {
+        lightmap: [lightmap.width, lightmap.height],
+        sh_order: settings.sh_order,
+        mesh_corners,
+        corner_uvs: lightmap.corners.concat(),
+        receiver_texels: receivers.list.iter().map(|r| r.texel).collect(),
+        receiver_clusters: clusters.cluster_of.clone(),
+        receiver_offsets: clusters.offsets.clone(),
+        receiver_sky: transport.sky.clone(),
+        coordinates: clusters.coordinates.clone(),
+        probes: probes.positions.iter().map(|p| p.to_array()).collect(),
+        probe_side: settings.probe_side,
+        probe_hits: views.hits,
+        cluster_probe_starts,
+        cluster_probes: clusters
+            .list
+            .iter()
+            .flat_map(|c| c.probes.iter().copied())
+            .collect(),
+        cluster_basis: clusters.list.iter().map(|c| c.basis as u32).collect(),
+        cluster_projection_starts,
+        projections: clusters
+            .list
+            .iter()
+            .flat_map(|c| c.projection.iter().copied())
+            .collect(),
+        report: serde_json::to_string(&report)?,
+    };
+    Ok((data, report))
 }

@@ -446,3 +446,76 @@ fn transport_matches_a_brute_force_gather() {
     );
     assert!(error <= 0.03, "error {:.2} %", 100.0 * error);
 }
+
+/// The bake file: a second bake reads what the first wrote, bit for bit; a truncated,
+/// damaged, older or other scene's file is not used, with the reason, and baked again.
+#[test]
+fn bake_file_round_trips_and_rejects_damage() {
+    use super::{load_or_bake, BakeSettings, Origin};
+    let ctx = context();
+    let dir = TempDir::new("bake_file");
+    let scene = cornell();
+    let settings = BakeSettings {
+        lightmap_size: 64,
+        probes: 32,
+        overlaps: 8,
+        probe_side: 16,
+        receiver_rays: 16,
+        sh_order: 2,
+    };
+    let path = dir.0.join("cornell.bake");
+    let bake =
+        |settings: &BakeSettings| load_or_bake(&ctx, &scene, settings, &path, false, None).unwrap();
+    let first = bake(&settings);
+    assert_eq!(first.origin, Origin::Computed(None));
+    let second = bake(&settings);
+    assert_eq!(second.origin, Origin::Cached);
+    assert!(
+        second.data == first.data,
+        "the file does not give back what was baked"
+    );
+    assert_eq!(second.report, first.report);
+
+    let bytes = std::fs::read(&path).unwrap();
+    let reason = |origin: Origin| match origin {
+        Origin::Computed(Some(why)) => why,
+        other => panic!("expected a rebake with a reason, got {other:?}"),
+    };
+    std::fs::write(&path, &bytes[..bytes.len() - 100]).unwrap();
+    let why = reason(bake(&settings).origin);
+    assert!(why.contains("truncated"), "{why}");
+    let mut damaged = bytes.clone();
+    let middle = damaged.len() / 2;
+    damaged[middle] ^= 0x40;
+    std::fs::write(&path, &damaged).unwrap();
+    let why = reason(bake(&settings).origin);
+    assert!(why.contains("damaged"), "{why}");
+    let mut older = bytes.clone();
+    older[8..12].copy_from_slice(&0u32.to_le_bytes());
+    std::fs::write(&path, &older).unwrap();
+    let why = reason(bake(&settings).origin);
+    assert!(why.contains("bake format 0"), "{why}");
+    std::fs::write(&path, b"not a bake").unwrap();
+    let why = reason(bake(&settings).origin);
+    assert!(why.contains("not a voxcone bake"), "{why}");
+    // Other settings under the same name: another key.
+    let why = reason(
+        bake(&BakeSettings {
+            probes: 27,
+            ..settings
+        })
+        .origin,
+    );
+    assert!(
+        why.contains("another version of the scene or other settings"),
+        "{why}"
+    );
+    assert_eq!(
+        bake(&BakeSettings {
+            probes: 27,
+            ..settings
+        })
+        .origin,
+        Origin::Cached
+    );
+}
