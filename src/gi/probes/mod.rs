@@ -85,6 +85,8 @@ pub struct BakeReport {
     pub receivers_inside: usize,
     /// Texels two charts claim (zero for a valid atlas).
     pub overlapping_texels: usize,
+    /// Receivers moved out of geometry (5.1.4).
+    pub receivers_shifted: usize,
     pub probe_candidates: usize,
     pub probes: usize,
     pub probe_spacing: f32,
@@ -98,6 +100,9 @@ pub struct BakeReport {
     /// The share of the receivers' rays that hit a surface no supporting probe sees
     /// (their light is lost).
     pub unseen_hit_share: f64,
+    /// Of those, the share whose surface no supporting probe faces from the receiver's
+    /// side (the rest failed the depth test: occluded, or too far along the texel).
+    pub unseen_from_the_side_share: f64,
     /// The receivers' transport: probe entries and their coefficients' memory.
     pub transport_entries: usize,
     pub transport_mib: f64,
@@ -208,9 +213,18 @@ pub fn compute(
     };
     let lightmap = Lightmap::generate(scene, settings.lightmap_size)?;
     lap("lightmap UVs");
-    let receivers = Receivers::place(scene, &lightmap);
+    let mut receivers = Receivers::place(scene, &lightmap);
+    let offset = 1e-4 * placement::static_bounds(scene).diagonal();
+    let host = crate::ray::host::HostRays::of_static(scene);
+    let shifted = receivers.shift_out_of_geometry(&host, 32, offset);
     lap("receivers");
-    let probes = Probes::place(scene, &receivers.list, settings.probes, settings.overlaps)?;
+    let probes = Probes::place(
+        scene,
+        &host,
+        &receivers.list,
+        settings.probes,
+        settings.overlaps,
+    )?;
     lap("probes");
     let overlaps = settings.overlaps as usize;
     let support: Vec<usize> = receivers
@@ -239,7 +253,7 @@ pub fn compute(
             order: settings.sh_order,
             rays: settings.receiver_rays as usize,
             overlaps,
-            offset: 1e-4 * placement::static_bounds(scene).diagonal(),
+            offset,
         },
     )?;
     lap("receiver transport");
@@ -289,6 +303,7 @@ pub fn compute(
         receivers: receivers.list.len(),
         receivers_inside: receivers.inside(),
         overlapping_texels: receivers.overlaps,
+        receivers_shifted: shifted,
         probe_candidates: probes.candidates,
         probes: probes.positions.len(),
         probe_spacing: probes.spacing,
@@ -298,6 +313,7 @@ pub fn compute(
         probe_rays: views.hits.len(),
         receiver_rays: receivers.list.len() * settings.receiver_rays as usize,
         unseen_hit_share: transport.unseen as f64 / transport.hits.max(1) as f64,
+        unseen_from_the_side_share: transport.unseen_side as f64 / transport.unseen.max(1) as f64,
         transport_entries: transport.probes.len(),
         transport_mib: (transport.alpha.len() * 4 + transport.probes.len() * 4) as f64 / 1048576.0,
         clusters: clusters.list.len(),

@@ -66,10 +66,12 @@ pub fn static_bounds(scene: &Scene) -> Aabb {
 }
 
 impl Probes {
-    /// About `desired` probes for `scene`, each supporting the receivers within a radius
+    /// About `desired` probes for `scene` (whose static meshes `rays` casts against),
+    /// each supporting the receivers within a radius
     /// that reaches `overlaps` probes from a typical receiver.
     pub fn place(
         scene: &Scene,
+        rays: &HostRays,
         receivers: &[Receiver],
         desired: u32,
         overlaps: u32,
@@ -168,7 +170,6 @@ impl Probes {
         // where 97 % of all candidates see no back at all. A tenth is allowed for open,
         // one-sided surfaces seen from behind (Sponza's curtains and plants: 3.5 % of
         // its candidates see 20-50 % backs).
-        let rays = HostRays::of_static(scene);
         let directions = super::sh::sphere_directions(32);
         candidates.retain(|c| {
             let (mut hits, mut back) = (0, 0);

@@ -13,6 +13,7 @@
 use glam::{Mat3, Vec2, Vec3};
 
 use super::lightmap::Lightmap;
+use crate::ray::host::HostRays;
 use crate::scene::Scene;
 
 /// One receiver.
@@ -213,6 +214,45 @@ impl Receivers {
             index,
             overlaps,
         }
+    }
+
+    /// Moves the receivers that lie inside geometry out of it (Sedláček 2019, 5.1.4): a
+    /// texel of a floor under a box, or at a contact, would gather the light of the
+    /// box's inside. From each receiver, `rays` rays over its hemisphere: where at least
+    /// 60 % meet a back face and none leaves the scene, the receiver moves along the
+    /// shortest of those rays to `offset` beyond the back face it met. Its texel stays.
+    /// Returns the receivers moved.
+    pub fn shift_out_of_geometry(&mut self, host: &HostRays, rays: usize, offset: f32) -> usize {
+        use rayon::prelude::*;
+        let pattern = super::casting::cosine_directions(rays);
+        let moved: Vec<Option<Vec3>> = self
+            .list
+            .par_iter()
+            .map(|r| {
+                let origin = r.position + r.normal * offset;
+                let mut back = 0;
+                let mut shortest: Option<(f32, Vec3)> = None;
+                for d in super::casting::oriented(&pattern, r.normal, 0.0) {
+                    let hit = host.closest(origin, d, 0.0)?;
+                    if !hit.front {
+                        back += 1;
+                        if shortest.is_none_or(|(t, _)| hit.t < t) {
+                            shortest = Some((hit.t, d));
+                        }
+                    }
+                }
+                let (t, d) = shortest?;
+                (back * 10 >= rays * 6).then(|| origin + d * (t + offset))
+            })
+            .collect();
+        let mut count = 0;
+        for (r, m) in self.list.iter_mut().zip(moved) {
+            if let Some(p) = m {
+                r.position = p;
+                count += 1;
+            }
+        }
+        count
     }
 
     /// Receivers whose texel's centre lies on the surface.

@@ -133,7 +133,14 @@ fn probes_lie_in_free_space_and_support_every_receiver() {
     let scene = cornell();
     let lightmap = Lightmap::generate(&scene, 128).unwrap();
     let receivers = Receivers::place(&scene, &lightmap);
-    let probes = Probes::place(&scene, &receivers.list, 64, 10).unwrap();
+    let probes = Probes::place(
+        &scene,
+        &crate::ray::host::HostRays::of_static(&scene),
+        &receivers.list,
+        64,
+        10,
+    )
+    .unwrap();
     assert_eq!(
         probes.positions.len(),
         64,
@@ -218,7 +225,13 @@ fn a_scene_without_free_space_or_static_triangles_says_so() {
     let scene = Scene::load(&dir.0.join("box.obj"), &LoadOptions::default()).unwrap();
     let lightmap = Lightmap::generate(&scene, 64).unwrap();
     let receivers = Receivers::place(&scene, &lightmap);
-    let text = error_text(Probes::place(&scene, &receivers.list, 16, 4));
+    let text = error_text(Probes::place(
+        &scene,
+        &crate::ray::host::HostRays::of_static(&scene),
+        &receivers.list,
+        16,
+        4,
+    ));
     assert!(text.contains("no free space"), "{text}");
 
     let moving = dir.write(
@@ -257,8 +270,11 @@ fn bake_transport(
 ) -> Baked {
     let scene = super::static_scene(scene);
     let lightmap = Lightmap::generate(&scene, size).unwrap();
-    let receivers = Receivers::place(&scene, &lightmap);
-    let probes = Probes::place(&scene, &receivers.list, probes, 8).unwrap();
+    let mut receivers = Receivers::place(&scene, &lightmap);
+    let host = crate::ray::host::HostRays::of_static(&scene);
+    let offset = 1e-4 * super::placement::static_bounds(&scene).diagonal();
+    receivers.shift_out_of_geometry(&host, 32, offset);
+    let probes = Probes::place(&scene, &host, &receivers.list, probes, 8).unwrap();
     let scene_rays = crate::ray::SceneRays::new(ctx, &scene, 1).unwrap();
     let mut queries = crate::ray::query::RayQueries::new(ctx, &scene_rays, 1 << 16).unwrap();
     let triangles = crate::ray::Triangles::of(&scene, 0.0, |_| true);
@@ -267,7 +283,7 @@ fn bake_transport(
         order: 3,
         rays,
         overlaps: 8,
-        offset: 1e-4 * super::placement::static_bounds(&scene).diagonal(),
+        offset,
     };
     let transport = super::transport::Transport::compute(
         &mut queries,
@@ -518,4 +534,45 @@ fn bake_file_round_trips_and_rejects_damage() {
         .origin,
         Origin::Cached
     );
+}
+
+/// Receivers inside geometry move out of it (5.1.4): on the built-in box, every floor
+/// receiver under a block (a ray along its normal meets the block's top from inside)
+/// moves, and from where it goes that ray no longer meets a back face; the walls'
+/// receivers, in the open, stay put.
+#[test]
+fn receivers_inside_geometry_move_out() {
+    let scene = cornell();
+    let lightmap = Lightmap::generate(&scene, 128).unwrap();
+    let mut receivers = Receivers::place(&scene, &lightmap);
+    let before = receivers.list.clone();
+    let host = crate::ray::host::HostRays::of_static(&scene);
+    let offset = 1e-4 * super::placement::static_bounds(&scene).diagonal();
+    // On the floor, and the block's top seen from inside straight above (the ceiling's
+    // texels above the one-sided light see its back too, but the rest of the room
+    // besides, and stay).
+    let inside = |r: &super::receivers::Receiver| {
+        r.normal.y > 0.99
+            && r.position.y < 0.01
+            && host
+                .closest(r.position + r.normal * offset, r.normal, 0.0)
+                .is_some_and(|h| !h.front)
+    };
+    let buried = before.iter().filter(|r| inside(r)).count();
+    let moved = receivers.shift_out_of_geometry(&host, 32, offset);
+    eprintln!("{buried} receivers inside the blocks, {moved} moved");
+    assert!(buried > 0, "no receiver under a block to test");
+    for (old, new) in before.iter().zip(&receivers.list) {
+        if inside(old) {
+            assert_ne!(old.position, new.position, "{old:?} stayed inside");
+            assert!(!inside(new), "{old:?} moved to {new:?}, still inside");
+        } else if old.inside && old.normal.y.abs() < 0.01 && old.position.y > 0.01 {
+            // The room's walls touch nothing (the ceiling's texels above the light,
+            // which covers most of their hemisphere 0.02 below, move under it).
+            let wall = old.position.x.abs() > 0.999 || old.position.z < -0.999;
+            if wall {
+                assert_eq!(old.position, new.position, "{old:?} moved from the open");
+            }
+        }
+    }
 }

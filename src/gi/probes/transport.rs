@@ -43,9 +43,12 @@ pub struct Transport {
     /// Per receiver, the cosine-weighted share of its hemisphere open to the sky (its
     /// irradiance from a sky of radiance S is sky · S; π for an open plane).
     pub sky: Vec<f32>,
-    /// Receiver rays that hit a surface, and those of them no supporting probe sees.
+    /// Receiver rays that hit a surface, those of them no supporting probe sees, and of
+    /// those the ones whose surface no supporting probe even faces from the side the
+    /// receiver sees it (the rest failed the depth test).
     pub hits: u64,
     pub unseen: u64,
+    pub unseen_side: u64,
 }
 
 /// How the transport is estimated.
@@ -81,6 +84,7 @@ impl Transport {
             sky: Vec::with_capacity(receivers.len()),
             hits: 0,
             unseen: 0,
+            unseen_side: 0,
         };
         let progress = Progress::new("receiver transport", receivers.len() as u64);
         for (b, batch) in receivers.chunks(BATCH).enumerate() {
@@ -118,6 +122,7 @@ impl Transport {
                 out.sky.push(g.sky);
                 out.hits += g.hits;
                 out.unseen += g.unseen;
+                out.unseen_side += g.unseen_side;
             }
             progress.set(((b + 1) * BATCH).min(receivers.len()) as u64);
         }
@@ -140,6 +145,7 @@ struct Gathered {
     sky: f32,
     hits: u64,
     unseen: u64,
+    unseen_side: u64,
 }
 
 /// What a receiver's gather reads.
@@ -159,7 +165,7 @@ impl Gather<'_> {
         let mut y = vec![0.0f64; n];
         let mut seen = Vec::with_capacity(support.len());
         let weight = std::f64::consts::PI / rays.len() as f64;
-        let (mut sky, mut count, mut unseen) = (0.0f64, 0u64, 0u64);
+        let (mut sky, mut count, mut unseen, mut unseen_side) = (0.0f64, 0u64, 0u64, 0u64);
         for (ray, hit) in rays.iter().zip(hits) {
             if hit.triangle == RAY_NONE {
                 sky += weight;
@@ -172,6 +178,7 @@ impl Gather<'_> {
             let normal = casting::triangle_normal(self.triangles, hit.triangle);
             seen.clear();
             let mut total = 0.0f64;
+            let mut facing = false;
             for (k, &(probe, w)) in support.iter().enumerate() {
                 let offset = point - self.probes.positions[probe as usize];
                 let distance = offset.length();
@@ -183,6 +190,7 @@ impl Gather<'_> {
                 // one-sided emitter would otherwise take the light the probes in front
                 // of it see.
                 let same_side = (normal.dot(towards) < 0.0) == (normal.dot(dir) < 0.0);
+                facing |= same_side;
                 if same_side && self.sees(probe as usize, towards, distance, normal) {
                     seen.push((k, towards, w as f64));
                     total += w as f64;
@@ -190,6 +198,7 @@ impl Gather<'_> {
             }
             if total <= 0.0 {
                 unseen += 1;
+                unseen_side += u64::from(!facing);
                 continue;
             }
             for &(k, towards, w) in &seen {
@@ -206,6 +215,7 @@ impl Gather<'_> {
             sky: sky as f32,
             hits: count,
             unseen,
+            unseen_side,
         }
     }
 
