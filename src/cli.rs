@@ -410,8 +410,13 @@ impl CommonArgs {
     }
 
     pub fn validation(&self) -> bool {
-        self.validation || std::env::var("VOXCONE_VALIDATION").is_ok_and(|v| v == "1")
+        validation_requested(self.validation)
     }
+}
+
+/// Whether validation is on: by the `--validation` flag, or VOXCONE_VALIDATION=1.
+pub fn validation_requested(flag: bool) -> bool {
+    flag || std::env::var("VOXCONE_VALIDATION").is_ok_and(|v| v == "1")
 }
 
 /// The built-in Cornell box in `assets/`: of the checkout `cargo run` runs from, else of

@@ -71,18 +71,23 @@ pub fn render_frames(
 
 /// As [`render_frames`], with `before(renderer, i)` called before frame i is recorded
 /// (to move a light, say).
+/// A context with validation (and synchronization validation) on, the test log set up.
+pub fn validating_context() -> Arc<Context> {
+    let _ = env_logger::builder().is_test(true).try_init();
+    Context::new(&ContextOptions {
+        validation: true,
+        ..Default::default()
+    })
+    .unwrap()
+}
+
 pub fn render_frames_with(
     scene: Scene,
     settings: RenderSettings,
     times: &[f32],
     mut before: impl FnMut(&mut Renderer, usize),
 ) -> (Arc<Context>, Renderer) {
-    let _ = env_logger::builder().is_test(true).try_init();
-    let ctx = Context::new(&ContextOptions {
-        validation: true,
-        ..Default::default()
-    })
-    .unwrap();
+    let ctx = validating_context();
     let extent = vk::Extent2D {
         width: 64,
         height: 64,

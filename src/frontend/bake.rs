@@ -3,7 +3,7 @@
 use anyhow::{Context as _, Result};
 
 use super::check_validation;
-use crate::cli::{default_scene, BakeArgs};
+use crate::cli::{default_scene, validation_requested, BakeArgs};
 use crate::gi::probes::file::default_path;
 use crate::gi::probes::{load_or_bake, BakeReport, Origin};
 use crate::scene::Scene;
@@ -15,7 +15,7 @@ pub fn run(args: &BakeArgs) -> Result<BakeReport> {
     let scene = Scene::load(&path, &Default::default())
         .with_context(|| format!("loading scene {}", path.display()))?;
     let ctx = Context::new(&ContextOptions {
-        validation: args.validation || std::env::var("VOXCONE_VALIDATION").is_ok_and(|v| v == "1"),
+        validation: validation_requested(args.validation),
         device: args.device.clone(),
         ..Default::default()
     })?;

@@ -11,7 +11,8 @@ use super::{check_buffer_size, SceneRays, Triangles};
 use crate::gpu_layout::{RayHit, RayQuery, RAY_ANY, RAY_CLOSEST, RAY_NONE};
 use crate::scene::testing::{shared_file, TempDir};
 use crate::scene::{LoadOptions, Scene};
-use crate::vk::{Context, ContextOptions};
+use crate::testing::validating_context;
+use crate::vk::Context;
 
 /// A small deterministic generator (xorshift), so that the rays are the same every run.
 struct Random(u64);
@@ -208,15 +209,6 @@ impl Soa {
     }
 }
 
-fn context() -> Arc<Context> {
-    let _ = env_logger::builder().is_test(true).try_init();
-    Context::new(&ContextOptions {
-        validation: true,
-        ..Default::default()
-    })
-    .unwrap()
-}
-
 /// Casts `queries` on the GPU against `scene` at time 0.
 fn gpu_hits(ctx: &Arc<Context>, scene: &Scene, queries: &[RayQuery]) -> Vec<RayHit> {
     let rays = SceneRays::new(ctx, scene, 1).unwrap();
@@ -301,7 +293,7 @@ fn ray_caster_matches_brute_force_on_sponza() {
         let d = forward + right * (x * half) + up * (y * half);
         queries.push(query(camera.position, d, RAY_CLOSEST));
     }
-    let ctx = context();
+    let ctx = validating_context();
     let gpu = gpu_hits(&ctx, &scene, &queries);
     let triangles = Triangles::of(&scene, 0.0, |_| true);
     let twin = Twin {
@@ -387,7 +379,7 @@ fn cut_outs_pass_rays_where_coverage_is_below_one_half() {
             queries.push(query(Vec3::new(x, 0.5, 1.0), Vec3::NEG_Z, kind));
         }
     }
-    let ctx = context();
+    let ctx = validating_context();
     let hits = gpu_hits(&ctx, &scene, &queries);
     for (q, hit) in queries.iter().zip(&hits) {
         let x = q.origin_tmin[0];

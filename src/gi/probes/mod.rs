@@ -227,12 +227,6 @@ pub fn compute(
     )?;
     lap("probes");
     let overlaps = settings.overlaps as usize;
-    let support: Vec<usize> = receivers
-        .list
-        .iter()
-        .map(|r| probes.support(r.position, overlaps).len())
-        .collect();
-    lap("probe support");
     let rays = SceneRays::new(ctx, scene, 1)?;
     let mut queries = RayQueries::new(ctx, &rays, 1 << 18)?;
     let triangles = Triangles::of(scene, 0.0, |_| true);
@@ -293,6 +287,12 @@ pub fn compute(
         }
         lap("preview");
     }
+    // Each receiver's transport entries are its supporting probes.
+    let support: Vec<usize> = transport
+        .offsets
+        .windows(2)
+        .map(|w| (w[1] - w[0]) as usize)
+        .collect();
     let supported = support.iter().filter(|&&n| n > 0).count();
     let report = BakeReport {
         scene: scene.source.display().to_string(),

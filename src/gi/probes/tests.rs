@@ -8,6 +8,7 @@ use super::placement::Probes;
 use super::receivers::{Receivers, NO_RECEIVER};
 use crate::scene::testing::{error_text, TempDir};
 use crate::scene::{LoadOptions, Scene};
+use crate::testing::validating_context;
 
 fn cornell() -> Scene {
     Scene::load(&crate::cli::default_scene(), &LoadOptions::default()).unwrap()
@@ -243,15 +244,6 @@ fn a_scene_without_free_space_or_static_triangles_says_so() {
     assert!(text.contains("no static triangles"), "{text}");
 }
 
-fn context() -> std::sync::Arc<crate::vk::Context> {
-    let _ = env_logger::builder().is_test(true).try_init();
-    crate::vk::Context::new(&crate::vk::ContextOptions {
-        validation: true,
-        ..Default::default()
-    })
-    .unwrap()
-}
-
 /// The bake of `scene` up to the transport, with the probes' λ from emission and sky.
 struct Baked {
     scene: Scene,
@@ -311,7 +303,7 @@ fn bake_transport(
 /// receiver's irradiance is π L: within 5 % at each (the issue's bound).
 #[test]
 fn furnace_gives_every_receiver_the_walls_irradiance() {
-    let ctx = context();
+    let ctx = validating_context();
     let dir = TempDir::new("probe_furnace");
     dir.write("box.mtl", "newmtl wall\nKd 0 0 0\nKe 0.5 0.5 0.5\n");
     let obj = "mtllib box.mtl\n\
@@ -361,7 +353,7 @@ fn glowing_cornell(dir: &TempDir) -> Scene {
 #[test]
 fn clustered_transport_reconstructs_the_irradiance() {
     use super::clusters::{ClusterSettings, Clusters};
-    let ctx = context();
+    let ctx = validating_context();
     let dir = TempDir::new("probe_clusters");
     let baked = bake_transport(&ctx, &glowing_cornell(&dir), 64, 64, 64);
     let settings = ClusterSettings::default();
@@ -400,7 +392,7 @@ fn clustered_transport_reconstructs_the_irradiance() {
 /// box glow in colours of their own, so the field varies with direction and visibility.
 #[test]
 fn transport_matches_a_brute_force_gather() {
-    let ctx = context();
+    let ctx = validating_context();
     let dir = TempDir::new("probe_alpha");
     let baked = bake_transport(&ctx, &glowing_cornell(&dir), 64, 64, 64);
     let host = crate::ray::host::HostRays::of_static(&baked.scene);
@@ -468,7 +460,7 @@ fn transport_matches_a_brute_force_gather() {
 #[test]
 fn bake_file_round_trips_and_rejects_damage() {
     use super::{load_or_bake, BakeSettings, Origin};
-    let ctx = context();
+    let ctx = validating_context();
     let dir = TempDir::new("bake_file");
     let scene = cornell();
     let settings = BakeSettings {
