@@ -54,6 +54,9 @@ pub enum GiMode {
     /// The path-traced reference: a path tracer with next-event estimation, in the
     /// references' conventions.
     Path,
+    /// Irradiance probes: light transport precomputed by ray casting from sparse probes
+    /// to lightmap receivers (Sedláček 2019), baked on first use.
+    Probes,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -105,6 +108,9 @@ pub struct CommonArgs {
     /// The path tracer's options (--gi path).
     #[command(flatten)]
     pub path: PathArgs,
+    /// The irradiance probes' options (--gi probes; their bake's settings).
+    #[command(flatten)]
+    pub probes: ProbeArgs,
     /// Leave out the direct light.
     #[arg(long)]
     pub no_direct: bool,
@@ -218,11 +224,6 @@ pub struct BakeArgs {
     /// Also write the report as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// The bake's file [default: in the user's cache folder,
-    /// $XDG_CACHE_HOME/voxcone/bakes or ~/.cache/voxcone/bakes, one per scene file and
-    /// settings].
-    #[arg(long)]
-    pub bake_file: Option<PathBuf>,
     /// Bake again even where the file is up to date.
     #[arg(long)]
     pub force: bool,
@@ -359,6 +360,11 @@ impl CommonArgs {
                 bail!("{option} sets the path tracer: it needs --gi path");
             }
         }
+        if self.gi != GiMode::Probes {
+            if let Some(option) = self.probes.given().first() {
+                bail!("{option} sets the irradiance probes: it needs --gi probes");
+            }
+        }
         if !matches!(self.gi, GiMode::Dense | GiMode::Octree) {
             if let Some(option) = self.vct.given().first() {
                 bail!("{option} works on the voxels: it needs --gi dense or --gi octree");
@@ -376,6 +382,19 @@ impl CommonArgs {
                 let settings = self.path.settings(scene, self.is_reference());
                 settings.check()?;
                 GiSettings::Path(settings)
+            }
+            GiMode::Probes => {
+                if !DebugView::SCREEN[..2].contains(&self.debug_view) {
+                    bail!(
+                        "--debug-view {:?}: --gi probes shows the indirect light only",
+                        self.debug_view
+                    );
+                }
+                GiSettings::Probes(crate::gi::probes::frame::ProbeSettings {
+                    bake: self.probes.settings()?,
+                    bake_file: self.probes.bake_file.clone(),
+                    bounces: true,
+                })
             }
             GiMode::Off => {
                 if self.debug_view != DebugView::None {

@@ -81,6 +81,10 @@ gpu_layout! {
         /// Screen contract (set 2): radiance refracted through transmissive surfaces (rgb) at reduced
         /// resolution, and 1 in alpha where the sampled pixel is transmissive (0 elsewhere), `rgba16f` storage.
         BINDING_SCREEN_TRANSMITTED = 10;
+        /// Screen contract (set 2): G-buffer triangle, its index in the scene plus one (0 where no
+        /// triangle was drawn, or where the device cannot number them: no geometry-shader
+        /// feature for `gl_PrimitiveID`), `r32ui` storage.
+        BINDING_SCREEN_TRIANGLE = 11;
 
         /// Voxel cone tracing (set 3): `VctUniforms` uniform buffer.
         BINDING_VCT_UNIFORMS = 0;
@@ -261,7 +265,8 @@ gpu_layout! {
         /// texels each: the static meshes' BVH from node 0, the moving meshes' after it
         /// (`RayUniforms.moving_root`), each node's inner children contiguous.
         BINDING_RAY_NODES = 1;
-        /// Ray casting (set 3): the triangles in the BVHs' leaf order, `RayTriangle`s as a
+        /// Ray casting (set 3): the triangles in the BVHs' leaf order (in the scene's order where a
+        /// pass looks them up by their index in the scene, `ray::surfaces`), `RayTriangle`s as a
         /// `usamplerBuffer` of three texels each: a vertex, two edges and the material, as
         /// the intersection test reads them.
         BINDING_RAY_TRIANGLES = 2;
@@ -317,6 +322,53 @@ gpu_layout! {
         /// Path tracer (set 3): rays cast since the counter was cleared, `uint[]` storage buffer
         /// (one word).
         BINDING_PATH_RAYS = 10;
+
+        /// Irradiance probes (set 3, after the surfaces' bindings `BINDING_RAY_TRIANGLES` to
+        /// `BINDING_RAY_TEXTURES`, the triangles in the scene's order): `ProbeUniforms` uniform buffer.
+        BINDING_PROBE_UNIFORMS = 8;
+        /// Irradiance probes (set 3): what each probe's rays met, a `usamplerBuffer` of a texel per
+        /// ray (`RayHit`: the scene's triangle or `RAY_NONE`, distance, barycentrics), probe after
+        /// probe, each through the texels of its equal-area octahedral map.
+        BINDING_PROBE_HITS = 9;
+        /// Irradiance probes (set 3): the harmonics of every probe ray's direction times its solid
+        /// angle, a `samplerBuffer` of one float per ray texel and coefficient (the same for
+        /// every probe).
+        BINDING_PROBE_SH = 10;
+        /// Irradiance probes (set 3): the probes' radiance in harmonics (λ), `vec4[]` storage buffer
+        /// of `coefficients` RGB entries per probe.
+        BINDING_PROBE_LAMBDA = 11;
+        /// Irradiance probes (set 3): per basis vector of every cluster, a `usamplerBuffer` texel:
+        /// the cluster's first probe in `BINDING_PROBE_CLUSTER_PROBES`, its probe count, the
+        /// vector's row in `BINDING_PROBE_PROJECTIONS`, and 0.
+        BINDING_PROBE_VECTORS = 12;
+        /// Irradiance probes (set 3): each cluster's probes, a `usamplerBuffer` of one index each.
+        BINDING_PROBE_CLUSTER_PROBES = 13;
+        /// Irradiance probes (set 3): the clusters' (Σ V^T)_k rows, a `samplerBuffer` of floats.
+        BINDING_PROBE_PROJECTIONS = 14;
+        /// Irradiance probes (set 3): the clusters' basis vectors b this frame, `vec4[]` storage
+        /// buffer, one RGB entry per basis vector.
+        BINDING_PROBE_BASIS = 15;
+        /// Irradiance probes (set 3): per receiver, a `usamplerBuffer` texel: its lightmap texel
+        /// (x | y << 16), where its coordinates start, its cluster's first basis vector, its
+        /// basis count.
+        BINDING_PROBE_RECEIVERS = 16;
+        /// Irradiance probes (set 3): the receivers' coordinates (rows of U_k) and, after them, each
+        /// receiver's sky factor, a `samplerBuffer` of floats.
+        BINDING_PROBE_COORDINATES = 17;
+        /// Irradiance probes (set 3): this frame's lightmap, the irradiance / π of each receiver,
+        /// `rgba16f` storage image.
+        BINDING_PROBE_LIGHTMAP = 18;
+        /// Irradiance probes (set 3): the same lightmap, `sampler2D` (bilinear).
+        BINDING_PROBE_LIGHTMAP_SAMPLED = 19;
+        /// Irradiance probes (set 3): last frame's lightmap, `sampler2D` (bilinear): the bounces.
+        BINDING_PROBE_LIGHTMAP_PREVIOUS = 20;
+        /// Irradiance probes (set 3): the lightmap uvs of every triangle's corners in the scene's
+        /// order, a `samplerBuffer` of two floats each (negative for a moving mesh's).
+        BINDING_PROBE_CORNER_UVS = 21;
+        /// Irradiance probes (set 3): the probes' positions, a `samplerBuffer` of `vec4`s (xyz).
+        BINDING_PROBE_POSITIONS = 22;
+        /// Workgroup size of the probe passes.
+        PROBE_GROUP_SIZE = 64;
 
     }
 
@@ -730,6 +782,26 @@ gpu_layout! {
         uint pad1,
     }
 
+    /// The irradiance probes' counts, as their passes read them.
+    struct ProbeUniforms {
+        /// Probes.
+        uint probe_count,
+        /// Rays (map texels) per probe.
+        uint rays_per_probe,
+        /// Harmonic coefficients per colour channel, (order + 1)².
+        uint coefficients,
+        /// Receivers.
+        uint receiver_count,
+        /// Basis vectors of all clusters together.
+        uint vector_count,
+        /// Where the receivers' sky factors start in `BINDING_PROBE_COORDINATES`.
+        uint sky_offset,
+        /// 1: the relight adds last frame's lightmap times albedo (the bounces).
+        uint bounces,
+        /// Unused.
+        uint pad0,
+    }
+
     /// Push constants of every mesh draw.
     struct DrawPush {
         /// Object to world.
@@ -738,7 +810,7 @@ gpu_layout! {
         uint material,
         /// Index into the shadow view buffer (shadow pass only).
         uint shadow_view,
-        /// The mesh's first index in the index buffer (compute voxelization only: `BINDING_VCT_INDICES`).
+        /// The mesh's first index in the index buffer (`BINDING_VCT_INDICES` in compute voxelization; a third of it is the mesh's first triangle's index in the scene).
         uint first_index,
         /// Added to the mesh's indices (compute voxelization only).
         uint vertex_offset,

@@ -126,6 +126,7 @@ impl SceneDraw<'_> {
                     .mesh_transform(draw.mesh, self.time_s)
                     .to_cols_array_2d(),
                 material: draw.material,
+                first_index: draw.first_index,
                 ..Default::default()
             };
             record(draw, push);

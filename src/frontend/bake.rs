@@ -19,7 +19,7 @@ pub fn run(args: &BakeArgs) -> Result<BakeReport> {
         device: args.device.clone(),
         ..Default::default()
     })?;
-    let path = match &args.bake_file {
+    let path = match &args.probes.bake_file {
         Some(p) => p.clone(),
         None => default_path(&scene, &settings)?,
     };

@@ -22,6 +22,7 @@ use winit::window::Window;
 
 use crate::cli::{CommonArgs, GiMode};
 use crate::gi::path::cli::PathArgs;
+use crate::gi::probes::cli::ProbeArgs;
 use crate::gi::vct::cli::VctArgs;
 use crate::gi::vct::voxelize::Voxelizer;
 use crate::gi::{DebugView, GiSettings};
@@ -264,11 +265,12 @@ struct Shown<'a> {
     building: bool,
 }
 
-const TECHNIQUES: [(GiMode, &str); 4] = [
+const TECHNIQUES: [(GiMode, &str); 5] = [
     (GiMode::Off, "off"),
     (GiMode::Dense, "dense"),
     (GiMode::Octree, "octree"),
     (GiMode::Path, "path"),
+    (GiMode::Probes, "probes"),
 ];
 
 fn contents(ui: &mut egui::Ui, view: &mut PanelView, shown: &Shown, requests: &mut Vec<Request>) {
@@ -395,10 +397,13 @@ fn switch_technique(args: &mut CommonArgs, mode: GiMode) {
     match mode {
         GiMode::Dense => args.vct.octree_depth = None,
         GiMode::Octree => {}
-        GiMode::Off | GiMode::Path => args.vct = VctArgs::default(),
+        GiMode::Off | GiMode::Path | GiMode::Probes => args.vct = VctArgs::default(),
     }
     if mode != GiMode::Path {
         args.path = PathArgs::default();
+    }
+    if mode != GiMode::Probes {
+        args.probes = ProbeArgs::default();
     }
     args.debug_view = DebugView::None;
 }
@@ -538,7 +543,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                 );
             }
         }
-        GiSettings::Off => {}
+        GiSettings::Off | GiSettings::Probes(_) => {}
     }
     rebuild
 }

@@ -9,8 +9,8 @@
 //!
 //! A technique is a folder here with its shaders in the `glsl/gi/` folder of the same
 //! name, an arm of [`GiSettings`] and of [`create`]; README.md, "Adding a technique",
-//! lists what else it touches. Today: voxel cone tracing ([`vct`]) and the path-traced
-//! reference ([`path`]).
+//! lists what else it touches. Today: voxel cone tracing ([`vct`]), the path-traced
+//! reference ([`path`]) and irradiance probes ([`probes`]).
 
 pub mod path;
 pub mod probes;
@@ -39,6 +39,8 @@ pub enum GiSettings {
     ConeTracing(vct::VctSettings),
     /// The path-traced reference ([`path`]).
     Path(path::PathSettings),
+    /// Irradiance probes ([`probes`]).
+    Probes(probes::frame::ProbeSettings),
 }
 
 impl GiSettings {
@@ -67,6 +69,7 @@ pub fn create(inputs: &Inputs, settings: &GiSettings) -> Result<Option<Box<dyn T
         GiSettings::Off => None,
         GiSettings::ConeTracing(vct) => Some(vct::create(inputs, vct)?),
         GiSettings::Path(path) => Some(Box::new(path::PathTracer::new(inputs, path)?)),
+        GiSettings::Probes(probes) => Some(Box::new(probes::frame::ProbeGi::new(inputs, probes)?)),
     })
 }
 

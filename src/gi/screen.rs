@@ -79,6 +79,7 @@ impl Screen {
             Binding::new(layout::BINDING_SCREEN_SHADOW, storage, compute),
             Binding::new(layout::BINDING_SCREEN_SPECULAR, storage, compute),
             Binding::new(layout::BINDING_SCREEN_TRANSMITTED, storage, compute),
+            Binding::new(layout::BINDING_SCREEN_TRIANGLE, storage, compute),
         ];
         let sets = DescriptorSets::new(ctx, "screen", &bindings, 1)?;
         let set = sets.allocate("screen")?;
@@ -198,6 +199,7 @@ impl Screen {
                 gbuffer.transmission.view,
             )
             .storage_image(layout::BINDING_SCREEN_EMISSION, gbuffer.emission.view)
+            .storage_image(layout::BINDING_SCREEN_TRIANGLE, gbuffer.triangle.view)
             .sampled_image(
                 layout::BINDING_SCREEN_DEPTH,
                 gbuffer.depth.view,

@@ -17,11 +17,13 @@ pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// glsl/common/frame.glsl).
 pub const DEPTH_CLEAR: f32 = 0.0;
 pub const TRANSMISSION_FORMAT: vk::Format = vk::Format::R16G16_SFLOAT;
-const COLOR_FORMATS: [vk::Format; 4] = [
+pub const TRIANGLE_FORMAT: vk::Format = vk::Format::R32_UINT;
+const COLOR_FORMATS: [vk::Format; 5] = [
     COLOR_FORMAT,
     COLOR_FORMAT,
     COLOR_FORMAT,
     TRANSMISSION_FORMAT,
+    TRIANGLE_FORMAT,
 ];
 
 /// The G-buffer images of one resolution.
@@ -34,6 +36,9 @@ pub struct GBuffer {
     pub emission: Image,
     /// r transmittance (1 - MTL d), g index of refraction (MTL Ni).
     pub transmission: Image,
+    /// The triangle drawn, its index in the scene plus one (0 for none, and everywhere on a
+    /// device without the geometry-shader feature, which `gl_PrimitiveID` needs).
+    pub triangle: Image,
     pub depth: Image,
 }
 
@@ -52,6 +57,7 @@ impl GBuffer {
             normal: color("gbuffer normal", COLOR_FORMAT)?,
             emission: color("gbuffer emission", COLOR_FORMAT)?,
             transmission: color("gbuffer transmission", TRANSMISSION_FORMAT)?,
+            triangle: color("gbuffer triangle", TRIANGLE_FORMAT)?,
             depth: Image::new(
                 ctx,
                 "gbuffer depth",
@@ -69,12 +75,13 @@ impl GBuffer {
         self.depth.extent_2d()
     }
 
-    fn colors(&self) -> [&Image; 4] {
+    fn colors(&self) -> [&Image; 5] {
         [
             &self.albedo,
             &self.normal,
             &self.emission,
             &self.transmission,
+            &self.triangle,
         ]
     }
 
@@ -91,6 +98,18 @@ pub struct GBufferPass {
 impl GBufferPass {
     pub fn new(ctx: &Arc<Context>, set_layouts: &[vk::DescriptorSetLayout]) -> Result<Self> {
         use crate::vk::shaders as s;
+        // Numbering the triangles needs gl_PrimitiveID, hence the geometry-shader feature.
+        let [plain, mapped] = if ctx.features.geometry_shader {
+            [
+                s::PASSES_GBUFFER_GBUFFER_FRAG_TRIANGLE_IDS,
+                s::PASSES_GBUFFER_GBUFFER_FRAG_NORMAL_MAPS_TRIANGLE_IDS,
+            ]
+        } else {
+            [
+                s::PASSES_GBUFFER_GBUFFER_FRAG,
+                s::PASSES_GBUFFER_GBUFFER_FRAG_NORMAL_MAPS,
+            ]
+        };
         let pipeline = |name, fragment| {
             Pipeline::graphics(
                 ctx,
@@ -115,11 +134,8 @@ impl GBufferPass {
         };
         Ok(Self {
             pipelines: [
-                pipeline("gbuffer", s::PASSES_GBUFFER_GBUFFER_FRAG)?,
-                pipeline(
-                    "gbuffer with normal maps",
-                    s::PASSES_GBUFFER_GBUFFER_FRAG_NORMAL_MAPS,
-                )?,
+                pipeline("gbuffer", plain)?,
+                pipeline("gbuffer with normal maps", mapped)?,
             ],
         })
     }

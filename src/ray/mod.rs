@@ -13,6 +13,7 @@ mod atlas;
 mod bvh;
 pub mod host;
 pub mod query;
+pub mod surfaces;
 #[cfg(test)]
 mod tests;
 
@@ -23,16 +24,12 @@ use anyhow::{bail, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
+use self::surfaces::{struct_texels, Materials};
 use crate::gpu_layout::{
-    self as layout, BvhNode, GpuMaterial, RayEmitter, RayShading, RayTriangle, RayUniforms,
-    RAY_NONE,
+    self as layout, BvhNode, RayEmitter, RayShading, RayTriangle, RayUniforms, RAY_NONE,
 };
 use crate::scene::Scene;
-use crate::scene_gpu::{gpu_materials, upload_texture};
-use crate::vk::{
-    memory_barrier, sampler_info, upload_buffer, Binding, Buffer, Context, Image, OneShot, Sampler,
-    SetWriter, TexelBuffer,
-};
+use crate::vk::{memory_barrier, Binding, Buffer, Context, OneShot, SetWriter, TexelBuffer};
 pub use bvh::{Bvh, Triangles};
 
 /// What building the static BVH took and made, for `bench` and the logs.
@@ -56,12 +53,8 @@ pub struct SceneRays {
     nodes: TexelBuffer,
     triangles: TexelBuffer,
     shading: TexelBuffer,
-    materials: TexelBuffer,
     emitters: TexelBuffer,
-    textures: TexelBuffer,
-    atlas: Image,
-    /// Referenced by the sets the rays are written into.
-    atlas_sampler: Sampler,
+    materials: Materials,
     /// Nodes and triangles of the static part (the moving meshes' follow).
     static_nodes: u32,
     static_triangles: u32,
@@ -75,7 +68,7 @@ pub struct SceneRays {
 }
 
 /// The stages that cast rays.
-const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::COMPUTE;
+pub(crate) const STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::COMPUTE;
 
 /// The most triangles the BVHs hold: a triangle's shading is texel 4i of its buffer, an
 /// `int` in GLSL.
@@ -93,25 +86,10 @@ fn check_depth(depth: u32, what: &str) -> Result<()> {
     Ok(())
 }
 
-/// Refuses a buffer of `size` bytes beyond `limit`, the most the device binds in one
-/// texel buffer, naming both.
-fn check_buffer_size(name: &str, size: u64, limit: u64) -> Result<()> {
-    if size > limit {
-        bail!(
-            "the scene's {name} need {size} bytes ({:.1} MiB), more than the {limit} bytes \
-             ({:.1} MiB) the device binds in one texel buffer (maxTexelBufferElements of 16 \
-             bytes)",
-            size as f64 / 1048576.0,
-            limit as f64 / 1048576.0
-        );
-    }
-    Ok(())
-}
-
 /// The texel format of every buffer rays read: an integer format, whose fetches return
 /// every bit as stored (the indices kept in float lanes are denormals, which a float
 /// format's fetch may flush).
-const TEXEL_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
+pub(crate) const TEXEL_FORMAT: vk::Format = vk::Format::R32G32B32A32_UINT;
 
 impl SceneRays {
     /// The set-3 bindings every ray-casting pass starts with.
@@ -126,15 +104,11 @@ impl SceneRays {
             Binding::new(layout::BINDING_RAY_NODES, texels, STAGES),
             Binding::new(layout::BINDING_RAY_TRIANGLES, texels, STAGES),
             Binding::new(layout::BINDING_RAY_SHADING, texels, STAGES),
-            Binding::new(layout::BINDING_RAY_MATERIALS, texels, STAGES),
-            Binding::new(
-                layout::BINDING_RAY_ATLAS,
-                vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                STAGES,
-            ),
-            Binding::new(layout::BINDING_RAY_TEXTURES, texels, STAGES),
             Binding::new(layout::BINDING_RAY_EMITTERS, texels, STAGES),
         ]
+        .into_iter()
+        .chain(Materials::bindings())
+        .collect()
     }
 
     /// Builds the static meshes' BVH, uploads it, the texture atlas and the emitters, and
@@ -175,16 +149,8 @@ impl SceneRays {
         let node_capacity = static_nodes + moving_triangles + 1;
         let triangle_capacity = (static_triangles + moving_triangles).max(1);
         let one_shot = OneShot::new(ctx)?;
-        let limit = 16 * u64::from(ctx.properties.limits.max_texel_buffer_elements);
         let sized = |name: &str, element: usize, count: u32, data: &[u8]| {
-            let size = (element as u64 * u64::from(count)).max(16);
-            check_buffer_size(name, size, limit)?;
-            let mut bytes = data.to_vec();
-            bytes.resize(size as usize, 0);
-            let usage =
-                vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
-            let buffer = upload_buffer(ctx, &one_shot, name, &bytes, usage)?;
-            TexelBuffer::new(name, buffer, TEXEL_FORMAT)
+            struct_texels(ctx, &one_shot, name, element, count, data)
         };
         let nodes = sized(
             "ray BVH nodes",
@@ -212,31 +178,7 @@ impl SceneRays {
             emitter_count.max(1),
             bytemuck::cast_slice(&emitters),
         )?;
-        let max_side = ctx.properties.limits.max_image_dimension2_d;
-        let packed = atlas::pack(&scene.textures, max_side)?;
-        let texels = atlas::texels(&scene.textures, &packed);
-        let atlas = upload_texture(
-            ctx,
-            &one_shot,
-            "ray texture atlas",
-            vk::Format::R8G8B8A8_UNORM,
-            packed.width,
-            packed.height,
-            &[texels],
-        )?;
-        let textures = sized(
-            "ray texture rects",
-            std::mem::size_of::<[u32; 4]>(),
-            packed.rects.len() as u32,
-            bytemuck::cast_slice(&packed.rects),
-        )?;
-        let gpu_materials = gpu_materials(scene);
-        let materials = sized(
-            "ray materials",
-            std::mem::size_of::<GpuMaterial>(),
-            gpu_materials.len() as u32,
-            bytemuck::cast_slice(&gpu_materials),
-        )?;
+        let materials = Materials::new(ctx, &one_shot, scene)?;
         let bounds = scene.swept_bounds();
         let uniforms = RayUniforms {
             static_root: built.root(0),
@@ -266,11 +208,6 @@ impl SceneRays {
                 )
             })
             .collect::<Result<_>>()?;
-        let atlas_sampler = Sampler::new(
-            ctx,
-            "ray texture atlas",
-            &sampler_info(vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE),
-        )?;
         Ok(Self {
             uniforms,
             nodes,
@@ -278,9 +215,6 @@ impl SceneRays {
             shading,
             materials,
             emitters,
-            textures,
-            atlas,
-            atlas_sampler,
             static_nodes,
             static_triangles,
             moving_triangles,
@@ -299,25 +233,17 @@ impl SceneRays {
 
     /// Writes the ray-casting bindings into `set`.
     pub fn write_set(&self, set: vk::DescriptorSet) {
-        SetWriter::new(&self.ctx, set)
+        let writer = SetWriter::new(&self.ctx, set)
             .buffer(
                 layout::BINDING_RAY_UNIFORMS,
                 vk::DescriptorType::UNIFORM_BUFFER,
                 self.uniforms.raw,
             )
-            .sampled_image(
-                layout::BINDING_RAY_ATLAS,
-                self.atlas.view,
-                self.atlas_sampler.raw,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            )
             .texel_buffer(layout::BINDING_RAY_NODES, self.nodes.view())
             .texel_buffer(layout::BINDING_RAY_TRIANGLES, self.triangles.view())
             .texel_buffer(layout::BINDING_RAY_SHADING, self.shading.view())
-            .texel_buffer(layout::BINDING_RAY_MATERIALS, self.materials.view())
-            .texel_buffer(layout::BINDING_RAY_TEXTURES, self.textures.view())
-            .texel_buffer(layout::BINDING_RAY_EMITTERS, self.emitters.view())
-            .apply();
+            .texel_buffer(layout::BINDING_RAY_EMITTERS, self.emitters.view());
+        self.materials.write(writer).apply();
     }
 
     /// Whether the scene has moving meshes, whose BVH [`Self::record_moving`] rebuilds.
@@ -421,19 +347,16 @@ impl SceneRays {
 
     /// GPU memory of the ray-casting resources, by name.
     pub fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
-        vec![
+        let mut bytes = vec![
             ("ray_bvh_nodes", self.nodes.buffer.size),
             (
                 "ray_triangles",
                 self.triangles.buffer.size + self.shading.buffer.size,
             ),
-            ("ray_texture_atlas", self.atlas.memory_bytes()),
             ("ray_emitters", self.emitters.buffer.size),
-            (
-                "ray_materials",
-                self.materials.buffer.size + self.textures.buffer.size,
-            ),
-        ]
+        ];
+        bytes.extend(self.materials.memory_bytes());
+        bytes
     }
 }
 

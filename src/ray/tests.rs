@@ -7,7 +7,8 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::query::RayQueries;
-use super::{check_buffer_size, SceneRays, Triangles};
+use super::surfaces::check_buffer_size;
+use super::{SceneRays, Triangles};
 use crate::gpu_layout::{RayHit, RayQuery, RAY_ANY, RAY_CLOSEST, RAY_NONE};
 use crate::scene::testing::{shared_file, TempDir};
 use crate::scene::{LoadOptions, Scene};
@@ -402,8 +403,8 @@ fn cut_outs_pass_rays_where_coverage_is_below_one_half() {
 #[test]
 fn a_buffer_beyond_the_device_limit_is_refused_with_its_size() {
     let limit = 1u64 << 27;
-    assert!(check_buffer_size("ray triangles", limit, limit).is_ok());
-    let error = check_buffer_size("ray triangles", limit + 16, limit)
+    assert!(check_buffer_size("ray triangles", limit, limit, 16).is_ok());
+    let error = check_buffer_size("ray triangles", limit + 16, limit, 16)
         .unwrap_err()
         .to_string();
     for part in [

@@ -12,6 +12,7 @@ layout(set = SET_SCREEN, binding = BINDING_SCREEN_ALBEDO, rgba16f) uniform reado
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_NORMAL, rgba16f) uniform readonly image2D gbuffer_normal;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_DEPTH) uniform sampler2D gbuffer_depth;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_TRANSMISSION, rg16f) uniform readonly image2D gbuffer_transmission;
+layout(set = SET_SCREEN, binding = BINDING_SCREEN_TRIANGLE, r32ui) uniform readonly uimage2D gbuffer_triangle;
 
 // The full-resolution pixel that stands for reduced-resolution pixel `low`.
 ivec2 representative(ivec2 low) {

@@ -1,5 +1,7 @@
 #version 460
 // variant: NORMAL_MAPS
+// variant: TRIANGLE_IDS
+// variant: NORMAL_MAPS TRIANGLE_IDS
 // Writes the surface attributes the lighting pass needs; position comes from depth.
 #include "common/frame.glsl"
 #include "common/scene.glsl"
@@ -12,6 +14,7 @@ layout(location = 0) out vec4 out_albedo;   // rgb albedo, a specular (mean Ks)
 layout(location = 1) out vec4 out_normal;   // xyz world normal facing the camera, w roughness
 layout(location = 2) out vec4 out_emission; // rgb emitted radiance
 layout(location = 3) out vec2 out_transmission; // transmittance (1 - d), index of refraction
+layout(location = 4) out uint out_triangle;     // the triangle's index in the scene + 1 (0: none)
 
 #ifdef NORMAL_MAPS
 // Perturbs n by a tangent-space normal map with a cotangent frame from screen-space
@@ -73,4 +76,12 @@ void main() {
     out_normal = vec4(n, m.specular.a);
     out_emission = vec4(front ? material_emission(m, in_uv) : vec3(0.0), 0.0);
     out_transmission = vec2(transmission ? 1.0 - m.albedo.a : 0.0, m.emission.a);
+    // The scene's meshes lie in its index buffer in order, so a mesh's first triangle is a
+    // third of its first index. gl_PrimitiveID needs the geometry-shader feature: without
+    // it, the variant without TRIANGLE_IDS writes 0, no triangle.
+#ifdef TRIANGLE_IDS
+    out_triangle = draw.first_index / 3u + uint(gl_PrimitiveID) + 1u;
+#else
+    out_triangle = 0u;
+#endif
 }

@@ -1,5 +1,7 @@
 //! The irradiance probes' command-line options.
 
+use std::path::PathBuf;
+
 use anyhow::{bail, Result};
 use clap::Args;
 
@@ -32,9 +34,30 @@ pub struct ProbeArgs {
     /// coefficients [default: 3].
     #[arg(long)]
     pub sh_order: Option<u32>,
+    /// The bake's file [default: in the user's cache folder,
+    /// $XDG_CACHE_HOME/voxcone/bakes or ~/.cache/voxcone/bakes, one per scene file and
+    /// settings].
+    #[arg(long)]
+    pub bake_file: Option<PathBuf>,
 }
 
 impl ProbeArgs {
+    /// The options given, as their flags.
+    pub fn given(&self) -> Vec<&'static str> {
+        [
+            (self.lightmap_size.is_some(), "--lightmap-size"),
+            (self.probes.is_some(), "--probes"),
+            (self.overlaps.is_some(), "--overlaps"),
+            (self.probe_side.is_some(), "--probe-side"),
+            (self.receiver_rays.is_some(), "--receiver-rays"),
+            (self.sh_order.is_some(), "--sh-order"),
+            (self.bake_file.is_some(), "--bake-file"),
+        ]
+        .into_iter()
+        .filter_map(|(set, flag)| set.then_some(flag))
+        .collect()
+    }
+
     /// The bake's settings: the command line over the defaults.
     pub fn settings(&self) -> Result<BakeSettings> {
         let d = BakeSettings::default();

@@ -12,6 +12,7 @@ pub mod casting;
 pub mod cli;
 pub mod clusters;
 pub mod file;
+pub mod frame;
 pub mod lightmap;
 pub mod octahedral;
 pub mod placement;

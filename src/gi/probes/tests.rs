@@ -568,3 +568,110 @@ fn receivers_inside_geometry_move_out() {
         }
     }
 }
+
+/// The irradiance of receiver `r` from the bake's clusters, given the probes' `lambda`
+/// and the sky's radiance: the host twin of `probe_basis` and `probe_receivers`.
+fn reconstructed(data: &super::file::BakeData, lambda: &[Vec3], sky: Vec3, r: usize) -> Vec3 {
+    let n = super::sh::coefficient_count(data.sh_order);
+    let c = data.receiver_clusters[r] as usize;
+    let probes = &data.cluster_probes
+        [data.cluster_probe_starts[c] as usize..data.cluster_probe_starts[c + 1] as usize];
+    let width = probes.len() * n;
+    let mut e = sky * data.receiver_sky[r];
+    for i in 0..data.cluster_basis[c] as usize {
+        let row =
+            &data.projections[data.cluster_projection_starts[c] as usize + i * width..][..width];
+        let mut b = Vec3::ZERO;
+        for (k, &p) in probes.iter().enumerate() {
+            for j in 0..n {
+                b += lambda[p as usize * n + j] * row[k * n + j];
+            }
+        }
+        e += b * data.coordinates[data.receiver_offsets[r] as usize + i];
+    }
+    e
+}
+
+/// The glowing box with no lights under a coloured sky, rendered with `--gi probes` and
+/// no bounces: the lightmap the GPU's relight, projection, basis and receivers passes
+/// write holds every receiver's irradiance / π as the host computes it from the same
+/// bake (the emission and sky each probe ray meets, projected onto the harmonics,
+/// through the clusters), within the lightmap's half-float rounding.
+#[test]
+fn the_frames_lightmap_matches_the_host_twin() {
+    use super::frame::{ProbeGi, ProbeSettings};
+    let dir = TempDir::new("probe_frame_twin");
+    let mut scene = glowing_cornell(&dir);
+    scene.lights.clear();
+    scene.sky = Vec3::new(0.2, 0.4, 0.8);
+    let bake_file = dir.0.join("box.bake");
+    let settings = ProbeSettings {
+        bake: super::BakeSettings {
+            lightmap_size: 64,
+            probes: 32,
+            overlaps: 8,
+            probe_side: 32,
+            receiver_rays: 32,
+            sh_order: 3,
+        },
+        bake_file: Some(bake_file.clone()),
+        bounces: false,
+    };
+    let render = crate::settings::RenderSettings {
+        gi: crate::gi::GiSettings::Probes(settings.clone()),
+        ..Default::default()
+    };
+    let (ctx, renderer) = crate::testing::render_frames(scene.clone(), render, &[0.0]);
+    assert_eq!(ctx.validation_messages(), 0);
+    let probes: &ProbeGi = renderer.gi_as().unwrap();
+    let [w, h] = probes.lightmap_size();
+    let bytes = crate::vk::read_back_image(
+        &ctx,
+        probes.lightmap(),
+        0,
+        ash::vk::Extent3D {
+            width: w,
+            height: h,
+            depth: 1,
+        },
+        8,
+        super::frame::LIGHTMAP_USE,
+    )
+    .unwrap();
+    let halves: Vec<half::f16> = bytes
+        .chunks_exact(2)
+        .map(|b| half::f16::from_le_bytes([b[0], b[1]]))
+        .collect();
+    let key = super::file::content_key(&scene, &settings.bake);
+    let data = super::file::BakeData::read(&bake_file, key).unwrap();
+    let statics = super::static_scene(&scene);
+    let triangles = crate::ray::Triangles::of(&statics, 0.0, |_| true);
+    let views = super::casting::ProbeViews {
+        side: data.probe_side as usize,
+        hits: data.probe_hits.clone(),
+    };
+    let basis = super::sh::Basis::new(data.sh_order);
+    let lambda =
+        super::relight::emitted_lambda(&statics, &triangles, &views, data.probes.len(), &basis);
+    let (mut worst, mut total) = (0.0f32, 0.0f32);
+    for r in 0..data.receiver_texels.len() {
+        let expected = reconstructed(&data, &lambda, scene.sky, r) / std::f32::consts::PI;
+        let [x, y] = data.receiver_texels[r];
+        let t = &halves[4 * (y * w + x) as usize..][..3];
+        let got = Vec3::new(t[0].to_f32(), t[1].to_f32(), t[2].to_f32());
+        let error = (got - expected).abs().max_element() / expected.max_element().max(1e-3);
+        worst = worst.max(error);
+        total += expected.max_element();
+    }
+    eprintln!(
+        "{} receivers, mean irradiance / π {:.3}, worst relative difference {:.4}",
+        data.receiver_texels.len(),
+        total / data.receiver_texels.len() as f32,
+        worst
+    );
+    assert!(
+        worst < 0.005,
+        "a receiver's texel is {:.2} % off the host's",
+        100.0 * worst
+    );
+}

@@ -1,0 +1,36 @@
+#version 460
+// The clusters' basis vectors (Sedláček 2019, 3.3.1.3), an invocation per vector: row i
+// of a cluster's (Σ V^T)_k times its probes' harmonics stacked, b_i = Σ_p Σ_j P_i,pj λ_pj.
+#include "gi/probes/probes.glsl"
+
+layout(local_size_x = PROBE_GROUP_SIZE) in;
+layout(constant_id = 0) const uint COEFFICIENTS = 16u;
+
+layout(set = SET_GI, binding = BINDING_PROBE_VECTORS) uniform usamplerBuffer vectors;
+layout(set = SET_GI, binding = BINDING_PROBE_CLUSTER_PROBES) uniform usamplerBuffer cluster_probes;
+layout(set = SET_GI, binding = BINDING_PROBE_PROJECTIONS) uniform samplerBuffer projections;
+layout(set = SET_GI, binding = BINDING_PROBE_LAMBDA, std430) readonly buffer LambdaBlock {
+    vec4 lambda[];
+};
+layout(set = SET_GI, binding = BINDING_PROBE_BASIS, std430) writeonly buffer BasisBlock {
+    vec4 basis[];
+};
+
+void main() {
+    uint v = gl_GlobalInvocationID.x;
+    if (v >= probes.vector_count) {
+        return;
+    }
+    uvec4 vector = texelFetch(vectors, int(v));
+    vec3 b = vec3(0.0);
+    int at = int(vector.z);
+    for (uint k = 0u; k < vector.y; k++) {
+        uint probe = texelFetch(cluster_probes, int(vector.x + k)).r;
+        uint first = probe * COEFFICIENTS;
+        for (uint j = 0u; j < COEFFICIENTS; j++) {
+            b += texelFetch(projections, at).r * lambda[first + j].rgb;
+            at++;
+        }
+    }
+    basis[v] = vec4(b, 0.0);
+}

@@ -1,0 +1,724 @@
+//! `--gi probes`: the frame of the irradiance probes (Sedláček 2019, 3.3), from a bake
+//! read or made when the technique starts ([`super::load_or_bake`]). Four compute passes,
+//! each named as its shader in `glsl/gi/probes/`:
+//! - `probe_relight`: the radiance every probe ray meets (the frame's direct light through
+//!   its shadow maps, emission, the sky, last frame's lightmap for the bounces), projected
+//!   onto the harmonics (λ);
+//! - `probe_basis`: each cluster's basis vectors from its probes' λ;
+//! - `probe_receivers`: each receiver's irradiance into the lightmap;
+//! - `probe_gather`: the lightmap at the uv of each pixel's triangle (the G-buffer numbers
+//!   them), as the screen contract's indirect term.
+//!
+//! Two lightmaps alternate: a frame writes one and its relight reads the other, last
+//! frame's. Visibility is the bake's: moving meshes neither block nor bounce light here,
+//! and have no lightmap (they get no indirect light until the grid of spatial receivers,
+//! 4.1, exists).
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{bail, Result};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+use super::file::BakeData;
+use super::sh::Basis;
+use super::{octahedral, BakeReport, BakeSettings, Origin};
+use crate::gi::{
+    DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
+    Switch, Technique,
+};
+use crate::gpu_layout::{self as layout, ProbeUniforms, RayHit, RAY_NONE};
+use crate::ray::surfaces::{texel_buffer, SceneTriangles};
+use crate::scene::Scene;
+use crate::vk::{
+    clear_to_zero, compute_to_compute, groups_2d, sampler_info, Binding, Buffer, Context,
+    DescriptorSets, Image, ImageDesc, ImageUse, OneShot, Pipeline, Sampler, SetWriter, TexelBuffer,
+};
+
+/// The technique's settings: the bake's, and where its file is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProbeSettings {
+    pub bake: BakeSettings,
+    /// The bake's file; `None`: the user's cache folder ([`super::file::default_path`]).
+    pub bake_file: Option<PathBuf>,
+    /// Each frame's relight adds last frame's lightmap (one bounce more per frame); off:
+    /// the lightmap holds the first bounce only.
+    pub bounces: bool,
+}
+
+impl Default for ProbeSettings {
+    fn default() -> Self {
+        Self {
+            bake: BakeSettings::default(),
+            bake_file: None,
+            bounces: true,
+        }
+    }
+}
+
+/// The format of the lightmaps: irradiance / π, HDR.
+const LIGHTMAP_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+/// How the lightmaps are used between frames: written as storage and sampled by compute
+/// passes, in the general layout throughout.
+pub(super) const LIGHTMAP_USE: ImageUse = ImageUse {
+    layout: vk::ImageLayout::GENERAL,
+    stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+    access: vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw()
+            | vk::AccessFlags2::SHADER_SAMPLED_READ.as_raw(),
+    ),
+};
+
+/// Bounces the first frame computes (relight, basis and receivers once per bounce, each
+/// reading the lightmap the last wrote), as the cone tracer's first frame computes its
+/// voxel bounces; every later frame adds one on top of the last frame's lightmap.
+const FIRST_FRAME_BOUNCES: u32 = 8;
+
+/// The most workgroups of one dispatch along x that every device runs.
+const MAX_GROUPS: u32 = 65535;
+
+/// The bake's tables as the passes read them, built on the host.
+struct Tables {
+    hits: Vec<[u32; 4]>,
+    harmonics: Vec<f32>,
+    positions: Vec<[f32; 4]>,
+    vectors: Vec<[u32; 4]>,
+    receivers: Vec<[u32; 4]>,
+    /// The receivers' coordinates, then their sky factors.
+    coordinates: Vec<f32>,
+    corner_uvs: Vec<[f32; 2]>,
+    uniforms: ProbeUniforms,
+}
+
+impl Tables {
+    /// The tables of `data`, baked from the static meshes of `scene`: its triangles are
+    /// renumbered from the static scene's order to the whole scene's.
+    fn new(scene: &Scene, data: &BakeData) -> Result<Self> {
+        let n = super::sh::coefficient_count(data.sh_order);
+        // The whole scene's index of each static triangle, and the corners' lightmap uvs
+        // of every triangle (moving meshes' negative: none).
+        let mut whole_of_static = Vec::new();
+        let mut corner_uvs = Vec::new();
+        let mut first = 0u32;
+        let mut static_mesh = 0usize;
+        for mesh in &scene.meshes {
+            let count = (mesh.indices.len() / 3) as u32;
+            if mesh.animation.is_none() {
+                let (start, end) = (
+                    data.mesh_corners[static_mesh] as usize,
+                    data.mesh_corners[static_mesh + 1] as usize,
+                );
+                if end - start != 3 * count as usize {
+                    bail!("the bake's lightmap uvs do not match the scene's meshes");
+                }
+                corner_uvs.extend_from_slice(&data.corner_uvs[start..end]);
+                whole_of_static.extend(first..first + count);
+                static_mesh += 1;
+            } else {
+                corner_uvs.extend(std::iter::repeat_n([-1.0f32; 2], 3 * count as usize));
+            }
+            first += count;
+        }
+        let hits = data
+            .probe_hits
+            .iter()
+            .map(|h: &RayHit| {
+                let triangle = if h.triangle == RAY_NONE {
+                    RAY_NONE
+                } else {
+                    whole_of_static[h.triangle as usize]
+                };
+                [triangle, h.t.to_bits(), h.u.to_bits(), h.v.to_bits()]
+            })
+            .collect();
+        let side = data.probe_side as usize;
+        let rays = side * side;
+        let basis = Basis::new(data.sh_order);
+        let solid_angle = 4.0 * std::f64::consts::PI / rays as f64;
+        let mut y = vec![0.0f64; n];
+        let mut harmonics = Vec::with_capacity(rays * n);
+        for t in 0..rays {
+            basis.eval_into(octahedral::texel_direction(t, side), &mut y);
+            harmonics.extend(y.iter().map(|y| (y * solid_angle) as f32));
+        }
+        let clusters = data.cluster_basis.len();
+        let mut first_vector = Vec::with_capacity(clusters);
+        let mut vectors = Vec::new();
+        for c in 0..clusters {
+            first_vector.push(vectors.len() as u32);
+            let probes = data.cluster_probe_starts[c + 1] - data.cluster_probe_starts[c];
+            let width = probes * n as u32;
+            for i in 0..data.cluster_basis[c] {
+                vectors.push([
+                    data.cluster_probe_starts[c],
+                    probes,
+                    data.cluster_projection_starts[c] + i * width,
+                    0,
+                ]);
+            }
+        }
+        let receivers = (0..data.receiver_texels.len())
+            .map(|r| {
+                let [x, y] = data.receiver_texels[r];
+                let c = data.receiver_clusters[r] as usize;
+                [
+                    x | y << 16,
+                    data.receiver_offsets[r],
+                    first_vector[c],
+                    data.cluster_basis[c],
+                ]
+            })
+            .collect();
+        let mut coordinates = data.coordinates.clone();
+        coordinates.extend_from_slice(&data.receiver_sky);
+        let uniforms = ProbeUniforms {
+            probe_count: data.probes.len() as u32,
+            rays_per_probe: rays as u32,
+            coefficients: n as u32,
+            receiver_count: data.receiver_texels.len() as u32,
+            vector_count: vectors.len() as u32,
+            sky_offset: data.coordinates.len() as u32,
+            bounces: 1,
+            pad0: 0,
+        };
+        Ok(Self {
+            hits,
+            harmonics,
+            positions: data
+                .probes
+                .iter()
+                .map(|p| [p[0], p[1], p[2], 0.0])
+                .collect(),
+            vectors,
+            receivers,
+            coordinates,
+            corner_uvs,
+            uniforms,
+        })
+    }
+}
+
+/// The bake's tables on the GPU.
+struct Uploaded {
+    hits: TexelBuffer,
+    harmonics: TexelBuffer,
+    positions: TexelBuffer,
+    vectors: TexelBuffer,
+    cluster_probes: TexelBuffer,
+    projections: TexelBuffer,
+    receivers: TexelBuffer,
+    coordinates: TexelBuffer,
+    corner_uvs: TexelBuffer,
+}
+
+impl Uploaded {
+    fn new(ctx: &Arc<Context>, tables: &Tables, data: &BakeData) -> Result<Self> {
+        use vk::Format as F;
+        let one_shot = OneShot::new(ctx)?;
+        let upload = |name: &str, format: F, texel: u64, bytes: &[u8]| {
+            texel_buffer(ctx, &one_shot, name, format, texel, bytes)
+        };
+        Ok(Self {
+            hits: upload(
+                "probe hits",
+                F::R32G32B32A32_UINT,
+                16,
+                bytemuck::cast_slice(&tables.hits),
+            )?,
+            harmonics: upload(
+                "probe ray harmonics",
+                F::R32_SFLOAT,
+                4,
+                bytemuck::cast_slice(&tables.harmonics),
+            )?,
+            positions: upload(
+                "probe positions",
+                F::R32G32B32A32_SFLOAT,
+                16,
+                bytemuck::cast_slice(&tables.positions),
+            )?,
+            vectors: upload(
+                "probe basis vectors",
+                F::R32G32B32A32_UINT,
+                16,
+                bytemuck::cast_slice(&tables.vectors),
+            )?,
+            cluster_probes: upload(
+                "probe clusters' probes",
+                F::R32_UINT,
+                4,
+                bytemuck::cast_slice(&data.cluster_probes),
+            )?,
+            projections: upload(
+                "probe cluster projections",
+                F::R32_SFLOAT,
+                4,
+                bytemuck::cast_slice(&data.projections),
+            )?,
+            receivers: upload(
+                "probe receivers",
+                F::R32G32B32A32_UINT,
+                16,
+                bytemuck::cast_slice(&tables.receivers),
+            )?,
+            coordinates: upload(
+                "probe receiver coordinates",
+                F::R32_SFLOAT,
+                4,
+                bytemuck::cast_slice(&tables.coordinates),
+            )?,
+            corner_uvs: upload(
+                "probe lightmap uvs",
+                F::R32G32_SFLOAT,
+                8,
+                bytemuck::cast_slice(&tables.corner_uvs),
+            )?,
+        })
+    }
+
+    fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
+        vec![
+            (
+                "probe_rays",
+                self.hits.buffer.size + self.harmonics.buffer.size + self.positions.buffer.size,
+            ),
+            (
+                "probe_clusters",
+                self.vectors.buffer.size
+                    + self.cluster_probes.buffer.size
+                    + self.projections.buffer.size,
+            ),
+            (
+                "probe_receivers",
+                self.receivers.buffer.size + self.coordinates.buffer.size,
+            ),
+            ("probe_lightmap_uvs", self.corner_uvs.buffer.size),
+        ]
+    }
+}
+
+/// The irradiance probes' frame.
+pub struct ProbeGi {
+    surfaces: SceneTriangles,
+    tables: Uploaded,
+    uniforms: Buffer,
+    lambda: Buffer,
+    basis: Buffer,
+    /// Written by alternate frames.
+    lightmaps: [Image; 2],
+    /// Referenced by the sets.
+    _sampler: Sampler,
+    _sets: DescriptorSets,
+    /// Set i writes lightmap i and reads the other as last frame's.
+    sets: [vk::DescriptorSet; 2],
+    relight: Pipeline,
+    basis_pass: Pipeline,
+    receivers: Pipeline,
+    gather: Pipeline,
+    counts: ProbeUniforms,
+    /// The lightmap the next frame writes.
+    next: usize,
+    /// The lightmaps are cleared before the next frame (after a restart).
+    clear: bool,
+    /// Relight iterations the next frame runs.
+    iterations: u32,
+    report: BakeReport,
+    origin: Origin,
+    /// Reading or baking, and uploading, in milliseconds.
+    prepare_ms: f64,
+    lightmap_size: [u32; 2],
+    extent: vk::Extent2D,
+    ctx: Arc<Context>,
+}
+
+impl ProbeGi {
+    pub fn new(inputs: &Inputs, settings: &ProbeSettings) -> Result<Self> {
+        let ctx = inputs.ctx;
+        if !ctx.features.geometry_shader {
+            bail!(
+                "--gi probes needs the geometry-shader feature, which this device ({}) lacks: \
+                 the G-buffer numbers its triangles with gl_PrimitiveID",
+                ctx.device_name()
+            );
+        }
+        let start = Instant::now();
+        let scene = inputs.scene;
+        let path = match &settings.bake_file {
+            Some(p) => p.clone(),
+            None => super::file::default_path(scene, &settings.bake)?,
+        };
+        let bake = super::load_or_bake(ctx, scene, &settings.bake, &path, false, None)?;
+        let data = &bake.data;
+        let [width, height] = data.lightmap;
+        let limit = ctx.properties.limits.max_image_dimension2_d;
+        if width > limit || height > limit {
+            bail!(
+                "the bake's lightmap is {width} × {height} texels, more than the {limit} this \
+                 device ({}) allows: bake with a smaller --lightmap-size",
+                ctx.device_name()
+            );
+        }
+        let tables = Tables::new(scene, data)?;
+        let counts = ProbeUniforms {
+            bounces: u32::from(settings.bounces),
+            ..tables.uniforms
+        };
+        if counts.probe_count > MAX_GROUPS {
+            bail!(
+                "the bake has {} probes: the relight runs a workgroup per probe, {MAX_GROUPS} at most",
+                counts.probe_count
+            );
+        }
+        let surfaces = SceneTriangles::new(ctx, scene)?;
+        let uploaded = Uploaded::new(ctx, &tables, data)?;
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let vec4 = 16u64;
+        let lambda = Buffer::new(
+            ctx,
+            "probe lambda",
+            (vec4 * u64::from(counts.probe_count * counts.coefficients)).max(vec4),
+            storage,
+            MemoryLocation::GpuOnly,
+        )?;
+        let basis = Buffer::new(
+            ctx,
+            "probe cluster basis",
+            (vec4 * u64::from(counts.vector_count)).max(vec4),
+            storage,
+            MemoryLocation::GpuOnly,
+        )?;
+        let uniforms = Buffer::with_data(
+            ctx,
+            "probe uniforms",
+            bytemuck::bytes_of(&counts),
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+        let lightmap = |i: usize| {
+            Image::new(
+                ctx,
+                &format!("probe lightmap {i}"),
+                ImageDesc::d2(
+                    LIGHTMAP_FORMAT,
+                    width,
+                    height,
+                    vk::ImageUsageFlags::STORAGE
+                        | vk::ImageUsageFlags::SAMPLED
+                        | vk::ImageUsageFlags::TRANSFER_DST
+                        | vk::ImageUsageFlags::TRANSFER_SRC,
+                ),
+            )
+        };
+        let lightmaps = [lightmap(0)?, lightmap(1)?];
+        OneShot::new(ctx)?.run("clearing the probe lightmaps", |cmd| {
+            for image in &lightmaps {
+                clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, LIGHTMAP_USE);
+            }
+            Ok(())
+        })?;
+        let sampler = Sampler::new(
+            ctx,
+            "probe lightmap",
+            &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::CLAMP_TO_EDGE),
+        )?;
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let texels = vk::DescriptorType::UNIFORM_TEXEL_BUFFER;
+        let sampled = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
+        let mut bindings = SceneTriangles::bindings();
+        bindings.extend([
+            Binding::new(
+                layout::BINDING_PROBE_UNIFORMS,
+                vk::DescriptorType::UNIFORM_BUFFER,
+                compute,
+            ),
+            Binding::new(layout::BINDING_PROBE_HITS, texels, compute),
+            Binding::new(layout::BINDING_PROBE_SH, texels, compute),
+            Binding::new(
+                layout::BINDING_PROBE_LAMBDA,
+                vk::DescriptorType::STORAGE_BUFFER,
+                compute,
+            ),
+            Binding::new(layout::BINDING_PROBE_VECTORS, texels, compute),
+            Binding::new(layout::BINDING_PROBE_CLUSTER_PROBES, texels, compute),
+            Binding::new(layout::BINDING_PROBE_PROJECTIONS, texels, compute),
+            Binding::new(
+                layout::BINDING_PROBE_BASIS,
+                vk::DescriptorType::STORAGE_BUFFER,
+                compute,
+            ),
+            Binding::new(layout::BINDING_PROBE_RECEIVERS, texels, compute),
+            Binding::new(layout::BINDING_PROBE_COORDINATES, texels, compute),
+            Binding::new(
+                layout::BINDING_PROBE_LIGHTMAP,
+                vk::DescriptorType::STORAGE_IMAGE,
+                compute,
+            ),
+            Binding::new(layout::BINDING_PROBE_LIGHTMAP_SAMPLED, sampled, compute),
+            Binding::new(layout::BINDING_PROBE_LIGHTMAP_PREVIOUS, sampled, compute),
+            Binding::new(layout::BINDING_PROBE_CORNER_UVS, texels, compute),
+            Binding::new(layout::BINDING_PROBE_POSITIONS, texels, compute),
+        ]);
+        let descriptor_sets = DescriptorSets::new(ctx, "probes", &bindings, 2)?;
+        let sets = [
+            descriptor_sets.allocate("probes 0")?,
+            descriptor_sets.allocate("probes 1")?,
+        ];
+        for (i, &set) in sets.iter().enumerate() {
+            surfaces.write_set(ctx, set);
+            let storage_buffer = vk::DescriptorType::STORAGE_BUFFER;
+            let t = &uploaded;
+            SetWriter::new(ctx, set)
+                .buffer(
+                    layout::BINDING_PROBE_UNIFORMS,
+                    vk::DescriptorType::UNIFORM_BUFFER,
+                    uniforms.raw,
+                )
+                .buffer(layout::BINDING_PROBE_LAMBDA, storage_buffer, lambda.raw)
+                .buffer(layout::BINDING_PROBE_BASIS, storage_buffer, basis.raw)
+                .texel_buffer(layout::BINDING_PROBE_HITS, t.hits.view())
+                .texel_buffer(layout::BINDING_PROBE_SH, t.harmonics.view())
+                .texel_buffer(layout::BINDING_PROBE_VECTORS, t.vectors.view())
+                .texel_buffer(
+                    layout::BINDING_PROBE_CLUSTER_PROBES,
+                    t.cluster_probes.view(),
+                )
+                .texel_buffer(layout::BINDING_PROBE_PROJECTIONS, t.projections.view())
+                .texel_buffer(layout::BINDING_PROBE_RECEIVERS, t.receivers.view())
+                .texel_buffer(layout::BINDING_PROBE_COORDINATES, t.coordinates.view())
+                .texel_buffer(layout::BINDING_PROBE_CORNER_UVS, t.corner_uvs.view())
+                .texel_buffer(layout::BINDING_PROBE_POSITIONS, t.positions.view())
+                .storage_image(layout::BINDING_PROBE_LIGHTMAP, lightmaps[i].view)
+                .sampled_image(
+                    layout::BINDING_PROBE_LIGHTMAP_SAMPLED,
+                    lightmaps[i].view,
+                    sampler.raw,
+                    vk::ImageLayout::GENERAL,
+                )
+                .sampled_image(
+                    layout::BINDING_PROBE_LIGHTMAP_PREVIOUS,
+                    lightmaps[1 - i].view,
+                    sampler.raw,
+                    vk::ImageLayout::GENERAL,
+                )
+                .apply();
+        }
+        let [frame, scene_layout, screen] = inputs.set_layouts;
+        let set_layouts = [frame, scene_layout, screen, descriptor_sets.layout];
+        use crate::vk::shaders as s;
+        let coefficients = [counts.coefficients];
+        let pipeline = |name: &str, spirv: &[u8], constants: &[u32]| {
+            Pipeline::compute_specialized(ctx, name, spirv, &set_layouts, 0, constants)
+        };
+        let relight = pipeline("probe_relight", s::GI_PROBES_RELIGHT_COMP, &coefficients)?;
+        let basis_pass = pipeline("probe_basis", s::GI_PROBES_BASIS_COMP, &coefficients)?;
+        let receivers = pipeline("probe_receivers", s::GI_PROBES_RECEIVERS_COMP, &[])?;
+        let gather = pipeline("probe_gather", s::GI_PROBES_GATHER_COMP, &[])?;
+        let prepare_ms = start.elapsed().as_secs_f64() * 1e3;
+        log::info!(
+            "irradiance probes: {} probes, {} receivers, {} clusters, {} basis vectors, \
+             lightmap {width} × {height} ({:.0} ms to {} and upload)",
+            counts.probe_count,
+            counts.receiver_count,
+            data.cluster_basis.len(),
+            counts.vector_count,
+            prepare_ms,
+            if bake.origin == Origin::Cached {
+                "read"
+            } else {
+                "bake"
+            }
+        );
+        Ok(Self {
+            surfaces,
+            tables: uploaded,
+            uniforms,
+            lambda,
+            basis,
+            lightmaps,
+            _sampler: sampler,
+            _sets: descriptor_sets,
+            sets,
+            relight,
+            basis_pass,
+            receivers,
+            gather,
+            counts,
+            next: 0,
+            clear: false,
+            iterations: if settings.bounces {
+                FIRST_FRAME_BOUNCES
+            } else {
+                1
+            },
+            report: bake.report,
+            origin: bake.origin,
+            prepare_ms,
+            lightmap_size: data.lightmap,
+            extent: vk::Extent2D::default(),
+            ctx: ctx.clone(),
+        })
+    }
+
+    /// The lightmap the last recorded frame wrote.
+    pub fn lightmap(&self) -> &Image {
+        &self.lightmaps[1 - self.next]
+    }
+
+    /// Its size in texels.
+    pub fn lightmap_size(&self) -> [u32; 2] {
+        self.lightmap_size
+    }
+}
+
+impl Technique for ProbeGi {
+    fn prepare(&mut self, _draw: &crate::scene_gpu::SceneDraw) -> Result<()> {
+        Ok(())
+    }
+
+    /// The lightmap is smooth: its gather runs at every pixel, which costs a texel fetch.
+    fn bind_screen(&mut self, extent: vk::Extent2D) -> Result<ScreenRequest> {
+        self.extent = extent;
+        Ok(ScreenRequest {
+            scale: 1,
+            plane_tolerance: 1.0 / self.report.texels_per_unit.max(f32::MIN_POSITIVE),
+        })
+    }
+
+    fn record_update(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        timer: &mut crate::vk::GpuTimer,
+        frame: &FrameInputs,
+    ) -> Result<()> {
+        let ctx = &self.ctx;
+        // Last frame's passes read and wrote what this one rewrites.
+        compute_to_compute(ctx, cmd);
+        if self.clear {
+            for image in &self.lightmaps {
+                clear_to_zero(ctx, cmd, image, LIGHTMAP_USE, LIGHTMAP_USE);
+            }
+            self.clear = false;
+        }
+        let c = &self.counts;
+        for _ in 0..self.iterations {
+            let sets = [
+                (layout::SET_FRAME, frame.draw.frame_set),
+                (layout::SET_GI, self.sets[self.next]),
+            ];
+            timer.begin(cmd, "probe_relight");
+            self.relight.dispatch(cmd, &sets, [c.probe_count, 1, 1]);
+            timer.end(cmd);
+            compute_to_compute(ctx, cmd);
+            timer.begin(cmd, "probe_basis");
+            let groups = c.vector_count.div_ceil(layout::PROBE_GROUP_SIZE);
+            self.basis_pass.dispatch(cmd, &sets, [groups, 1, 1]);
+            timer.end(cmd);
+            compute_to_compute(ctx, cmd);
+            timer.begin(cmd, "probe_receivers");
+            let groups = c.receiver_count.div_ceil(layout::PROBE_GROUP_SIZE);
+            self.receivers.dispatch(cmd, &sets, [groups, 1, 1]);
+            timer.end(cmd);
+            compute_to_compute(ctx, cmd);
+            self.next = 1 - self.next;
+        }
+        self.iterations = 1;
+        Ok(())
+    }
+
+    fn record_gather(
+        &self,
+        cmd: vk::CommandBuffer,
+        timer: &mut crate::vk::GpuTimer,
+        frame_set: vk::DescriptorSet,
+        screen: &Screen,
+        _options: &GatherOptions,
+    ) -> Gathered {
+        timer.begin(cmd, "probe_gather");
+        let sets = [
+            (layout::SET_FRAME, frame_set),
+            (layout::SET_SCREEN, screen.set()),
+            (layout::SET_GI, self.sets[1 - self.next]),
+        ];
+        self.gather.dispatch(
+            cmd,
+            &sets,
+            groups_2d(screen.reduced_extent(), layout::SCREEN_GROUP_SIZE),
+        );
+        timer.end(cmd);
+        Gathered::Terms
+    }
+
+    fn restart(&mut self) {
+        self.clear = true;
+        if self.counts.bounces != 0 {
+            self.iterations = FIRST_FRAME_BOUNCES;
+        }
+    }
+
+    fn shades_direct(&self) -> bool {
+        false
+    }
+
+    fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
+        let mut bytes = self.surfaces.memory_bytes();
+        bytes.extend(self.tables.memory_bytes());
+        bytes.push((
+            "probe_lambda_and_basis",
+            self.lambda.size + self.basis.size + self.uniforms.size,
+        ));
+        bytes.push((
+            "probe_lightmaps",
+            self.lightmaps.iter().map(Image::memory_bytes).sum(),
+        ));
+        bytes
+    }
+
+    fn stats(&self) -> Result<Vec<(String, f64)>> {
+        let r = &self.report;
+        Ok(vec![
+            ("probes".into(), r.probes as f64),
+            ("receivers".into(), r.receivers as f64),
+            ("clusters".into(), r.clusters as f64),
+            ("basis_vectors".into(), f64::from(self.counts.vector_count)),
+            ("probe_rays".into(), r.probe_rays as f64),
+            (
+                "sh_coefficients".into(),
+                f64::from(self.counts.coefficients),
+            ),
+            (
+                "lightmap_texels".into(),
+                f64::from(r.lightmap[0] * r.lightmap[1]),
+            ),
+            ("unseen_hit_share".into(), r.unseen_hit_share),
+        ])
+    }
+
+    fn preparation(&self) -> Option<Preparation> {
+        let how = match &self.origin {
+            Origin::Cached => "read the bake".to_string(),
+            Origin::Computed(None) => "baked".to_string(),
+            Origin::Computed(Some(why)) => format!("baked again ({why})"),
+        };
+        Some(Preparation {
+            summary: format!(
+                "irradiance probes: {how}, {} probes, {} receivers, {} clusters, in {:.0} ms",
+                self.report.probes, self.report.receivers, self.report.clusters, self.prepare_ms
+            ),
+            passes: Vec::new(),
+        })
+    }
+
+    fn debug_views(&self) -> &'static [DebugView] {
+        &[DebugView::None, DebugView::Indirect]
+    }
+
+    fn debug_levels(&self) -> u32 {
+        0
+    }
+
+    fn switches(&mut self) -> Vec<Switch<'_>> {
+        Vec::new()
+    }
+}
