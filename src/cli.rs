@@ -384,17 +384,28 @@ impl CommonArgs {
                 GiSettings::Path(settings)
             }
             GiMode::Probes => {
-                if !DebugView::SCREEN[..2].contains(&self.debug_view) {
+                if !crate::gi::probes::frame::DEBUG_VIEWS.contains(&self.debug_view) {
+                    let name = self
+                        .debug_view
+                        .to_possible_value()
+                        .map(|v| v.get_name().to_owned());
                     bail!(
-                        "--debug-view {:?}: --gi probes shows the indirect light only",
-                        self.debug_view
+                        "--debug-view {}: --gi probes offers none, indirect, lightmap, clusters \
+                         and probes",
+                        name.unwrap_or_default()
                     );
                 }
-                GiSettings::Probes(crate::gi::probes::frame::ProbeSettings {
-                    bake: self.probes.settings()?,
+                let settings = crate::gi::probes::frame::ProbeSettings {
+                    bake: self.probes.settings(scene)?,
                     bake_file: self.probes.bake_file.clone(),
-                    bounces: true,
-                })
+                    bounces: self
+                        .probes
+                        .probe_bounces
+                        .or(scene.probe_bounces)
+                        .unwrap_or(crate::gi::probes::frame::ProbeSettings::default().bounces),
+                };
+                settings.check()?;
+                GiSettings::Probes(settings)
             }
             GiMode::Off => {
                 if self.debug_view != DebugView::None {

@@ -257,6 +257,12 @@ gpu_layout! {
         DEBUG_VOXEL_RADIANCE = 5;
         /// `FrameUniforms.debug_view`: the octree's occupied nodes at depth `debug_level` below the leaves, edges drawn (`--gi svo`).
         DEBUG_OCTREE_NODES = 6;
+        /// `FrameUniforms.debug_view`: the probes' lightmap (irradiance / π) at each pixel, its nearest texel (`--gi probes`).
+        DEBUG_LIGHTMAP = 7;
+        /// `FrameUniforms.debug_view`: each receiver's cluster in its own colour (`--gi probes`).
+        DEBUG_CLUSTERS = 8;
+        /// `FrameUniforms.debug_view`: the probes as small spheres showing the mean radiance each sees, over the indirect light (`--gi probes`).
+        DEBUG_PROBES = 9;
 
         /// Scene ray casting (the first bindings of a set 3 that casts rays,
         /// `glsl/ray/rays.glsl`): `RayUniforms` uniform buffer.
@@ -367,6 +373,16 @@ gpu_layout! {
         BINDING_PROBE_CORNER_UVS = 21;
         /// Irradiance probes (set 3): the probes' positions, a `samplerBuffer` of `vec4`s (xyz).
         BINDING_PROBE_POSITIONS = 22;
+        /// Irradiance probes (set 3): what each probe ray met, decoded once (`surfaces.comp`), two
+        /// `uvec4`s per ray: position and albedo (RGBA8; alpha 0 for a miss); the normal towards
+        /// the probe (octahedral snorm16), the lightmap uv (unorm16, all ones for none) and the
+        /// emitted radiance (half floats), `uvec4[]` storage buffer.
+        BINDING_PROBE_SURFACES = 23;
+        /// Irradiance probes (set 3): the same buffer read by the relight, a `usamplerBuffer`.
+        BINDING_PROBE_SURFACES_READ = 24;
+        /// Irradiance probes (set 3): each lightmap texel's receiver's cluster (`RAY_NONE`: no
+        /// receiver), a `usamplerBuffer` of one index each, row by row (the clusters' debug view).
+        BINDING_PROBE_TEXEL_CLUSTERS = 25;
         /// Workgroup size of the probe passes.
         PROBE_GROUP_SIZE = 64;
 
@@ -798,8 +814,8 @@ gpu_layout! {
         uint sky_offset,
         /// 1: the relight adds last frame's lightmap times albedo (the bounces).
         uint bounces,
-        /// Unused.
-        uint pad0,
+        /// The radius of the spheres the probes' debug view draws, in world units.
+        float debug_radius,
     }
 
     /// Push constants of every mesh draw.

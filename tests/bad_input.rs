@@ -225,6 +225,46 @@ fn bad_bake_settings_and_scenes() {
         "[[mesh]]\npath = \"tri.obj\"\nanimate = { kind = \"spin\", axis = [0, 1, 0], deg_per_s = 45.0 }\n",
     );
     assert_fails_naming(&["bake", &moving], &["no static triangles"]);
+    assert_fails_naming(
+        &["bake", "--probe-bounces", "2"],
+        &["--probe-bounces", "not its bake"],
+    );
+}
+
+#[test]
+fn bad_probe_settings() {
+    assert_fails_naming(
+        &["render", "--sh-order", "5", "-o", "x.png"],
+        &["--sh-order", "needs --gi probes"],
+    );
+    assert_fails_naming(
+        &[
+            "render",
+            "--gi",
+            "probes",
+            "--probe-bounces",
+            "0",
+            "-o",
+            "x.png",
+        ],
+        &["--probe-bounces 0", "1 to 64"],
+    );
+    assert_fails_naming(
+        &["render", "--gi", "probes", "--sh-order", "8", "-o", "x.png"],
+        &["--sh-order 8", "0 to 7"],
+    );
+    assert_fails_naming(
+        &[
+            "render",
+            "--gi",
+            "probes",
+            "--debug-view",
+            "voxel-albedo",
+            "-o",
+            "x.png",
+        ],
+        &["--debug-view", "--gi probes"],
+    );
 }
 
 /// How a corpus case must end.

@@ -10,10 +10,13 @@ use crate::scene::Scene;
 use crate::vk::{Context, ContextOptions};
 
 pub fn run(args: &BakeArgs) -> Result<BakeReport> {
-    let settings = args.probes.settings()?;
+    if args.probes.probe_bounces.is_some() {
+        anyhow::bail!("--probe-bounces sets the frame of --gi probes, not its bake");
+    }
     let path = args.scene.clone().unwrap_or_else(default_scene);
     let scene = Scene::load(&path, &Default::default())
         .with_context(|| format!("loading scene {}", path.display()))?;
+    let settings = args.probes.settings(&scene.gi)?;
     let ctx = Context::new(&ContextOptions {
         validation: validation_requested(args.validation),
         device: args.device.clone(),

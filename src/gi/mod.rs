@@ -92,6 +92,14 @@ pub enum DebugView {
     /// The octree's occupied nodes `--debug-level` levels above the leaves, each in its
     /// own colour with its edges drawn (`--gi octree` only).
     OctreeNodes,
+    /// The irradiance probes' lightmap (irradiance / π) at each pixel, at its nearest
+    /// texel (`--gi probes` only).
+    Lightmap,
+    /// Each receiver's cluster in its own colour (`--gi probes` only).
+    Clusters,
+    /// The probes as small spheres showing the mean radiance each sees, over the indirect
+    /// light (`--gi probes` only).
+    Probes,
 }
 
 impl DebugView {
@@ -109,6 +117,9 @@ impl DebugView {
             DebugView::VoxelNormal => layout::DEBUG_VOXEL_NORMAL,
             DebugView::VoxelRadiance => layout::DEBUG_VOXEL_RADIANCE,
             DebugView::OctreeNodes => layout::DEBUG_OCTREE_NODES,
+            DebugView::Lightmap => layout::DEBUG_LIGHTMAP,
+            DebugView::Clusters => layout::DEBUG_CLUSTERS,
+            DebugView::Probes => layout::DEBUG_PROBES,
         }
     }
 

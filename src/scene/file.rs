@@ -61,6 +61,13 @@
 //! ao_distance_voxels = 4.0       # --ao-distance
 //! spp = 256                      # --spp (--gi path)
 //! max_depth = 2                  # --max-depth (--gi path): 2 is direct light only
+//! lightmap_size = 512            # --lightmap-size (--gi probes and bake)
+//! probes = 256                   # --probes
+//! overlaps = 10                  # --overlaps
+//! probe_side = 64                # --probe-side
+//! receiver_rays = 64             # --receiver-rays
+//! sh_order = 7                   # --sh-order
+//! probe_bounces = 8              # --probe-bounces (--gi probes)
 //! ```
 //!
 //! `spin` turns about the centre of the entry's object-space bounds at `deg_per_s`;

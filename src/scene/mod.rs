@@ -210,6 +210,16 @@ pub struct GiOverrides {
     pub spp: Option<u32>,
     /// The path tracer's longest path (a reference's `flags.max_depth`, where it has one).
     pub max_depth: Option<u32>,
+    /// The irradiance probes' bake: lightmap page size, desired probe count, N_OVERLAPS,
+    /// each probe's map side, rays per receiver, highest harmonic band.
+    pub lightmap_size: Option<u32>,
+    pub probes: Option<u32>,
+    pub overlaps: Option<u32>,
+    pub probe_side: Option<u32>,
+    pub receiver_rays: Option<u32>,
+    pub sh_order: Option<u32>,
+    /// The irradiance probes' bounces in a first frame.
+    pub probe_bounces: Option<u32>,
 }
 
 #[derive(Clone, Debug)]

@@ -19,4 +19,22 @@ vec2 lightmap_uv(uint i, vec2 bary) {
     vec2 c = texelFetch(corner_uvs, at + 2).xy;
     return a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y;
 }
+
+// A lightmap uv meaning "none" in the packed probe surfaces (`surfaces.comp`).
+const uint NO_LIGHTMAP_UV = 0xFFFFFFFFu;
+
+// A unit vector in two 16-bit signed components, by the octahedral map.
+uint pack_normal(vec3 n) {
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    return packSnorm2x16(e);
+}
+
+vec3 unpack_normal(uint packed) {
+    vec2 e = unpackSnorm2x16(packed);
+    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+    float t = max(-n.z, 0.0);
+    n.xy += vec2(n.x >= 0.0 ? -t : t, n.y >= 0.0 ? -t : t);
+    return normalize(n);
+}
 #endif

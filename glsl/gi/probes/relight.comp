@@ -9,7 +9,8 @@
 // - last frame's lightmap (irradiance / π) × albedo: each frame adds a bounce, as the
 //   cone tracer's voxel bounces do;
 // and the sky where a ray leaves the scene. Normal maps and specular lobes are not
-// seen by the probes (their lightmap is diffuse irradiance).
+// seen by the probes (their lightmap is diffuse irradiance). What each ray met was
+// decoded once (`surfaces.comp`).
 #include "common/direct_light.glsl"
 #include "gi/probes/probes.glsl"
 
@@ -17,9 +18,8 @@ layout(local_size_x = PROBE_GROUP_SIZE) in;
 // Harmonic coefficients per channel, (order + 1)².
 layout(constant_id = 0) const uint COEFFICIENTS = 16u;
 
-layout(set = SET_GI, binding = BINDING_PROBE_HITS) uniform usamplerBuffer probe_hits;
+layout(set = SET_GI, binding = BINDING_PROBE_SURFACES_READ) uniform usamplerBuffer probe_surfaces;
 layout(set = SET_GI, binding = BINDING_PROBE_SH) uniform samplerBuffer ray_harmonics;
-layout(set = SET_GI, binding = BINDING_PROBE_POSITIONS) uniform samplerBuffer probe_positions;
 layout(set = SET_GI, binding = BINDING_PROBE_LAMBDA, std430) writeonly buffer LambdaBlock {
     vec4 lambda[];
 };
@@ -31,55 +31,32 @@ layout(set = SET_GI, binding = BINDING_PROBE_LIGHTMAP_PREVIOUS) uniform sampler2
 const uint BLOCK = 16u;
 shared vec3 partial[BLOCK * PROBE_GROUP_SIZE];
 
-// The radiance arriving at probe position `origin` along the ray that met `hit`.
-vec3 radiance_along(uvec4 hit, vec3 origin) {
-    if (hit.x == RAY_NONE) {
+// The radiance arriving at the probe along ray `ray` (its surface decoded by
+// `surfaces.comp`).
+vec3 radiance_along(uint ray) {
+    uvec4 a = texelFetch(probe_surfaces, int(2u * ray));
+    if ((a.w >> 24u) == 0u) {
         return frame.sky_radiance.rgb;
     }
-    RayTriangle tri = ray_triangle(hit.x);
-    RayShading sh = ray_shading(hit.x);
-    vec2 bary = uintBitsToFloat(hit.zw);
-    GpuMaterial m = ray_material(floatBitsToUint(tri.v0.w));
-    vec3 p = tri.v0.xyz + tri.e1.xyz * bary.x + tri.e2.xyz * bary.y;
-    vec3 winding = normalize(cross(tri.e1.xyz, tri.e2.xyz));
-    bool front = dot(winding, origin - p) > 0.0;
-    vec3 ng = front ? winding : -winding;
-    float w = 1.0 - bary.x - bary.y;
-    vec3 n = sh.n0.xyz * w + sh.n1.xyz * bary.x + sh.n2.xyz * bary.y;
-    n = dot(n, n) > 1e-12 ? normalize(n) : ng;
-    n = dot(n, ng) < 0.0 ? -n : n;
-    vec2 uv = triangle_uv(hit.x, bary);
-    vec3 albedo = m.albedo.rgb;
-    if (m.albedo_texture != NO_TEXTURE) {
-        albedo *= texture_bilinear(m.albedo_texture, uv, true).rgb;
-    }
+    uvec4 b = texelFetch(probe_surfaces, int(2u * ray + 1u));
+    vec3 p = uintBitsToFloat(a.xyz);
+    vec3 albedo = unpackUnorm4x8(a.w).rgb;
+    vec3 n = unpack_normal(b.x);
     vec3 irradiance = vec3(0.0);
     for (uint i = 0u; i < frame.light_count; i++) {
         GpuLight light = lights[i];
         vec3 to_light;
         float dist;
         vec3 e = light_incident(light, p, n, to_light, dist);
-        // A light behind the surface (the interpolated normal may still face it) sends
-        // nothing.
-        if (dot(ng, to_light) > 0.0 && any(greaterThan(e, vec3(0.0)))) {
+        if (any(greaterThan(e, vec3(0.0)))) {
             // 3 × 3 taps: the probes' rays average over many hits, and the frame's
             // lighting pass keeps its 5 × 5 for what the camera sees.
-            irradiance += e * shadow_visibility(light, p, ng, 0.0, 1);
+            irradiance += e * shadow_visibility(light, p, n, 0.0, 1);
         }
     }
-    vec3 radiance = albedo / PI * irradiance;
-    if (front) {
-        vec3 emitted = m.emission.rgb;
-        if (m.emission_texture != NO_TEXTURE) {
-            emitted *= texture_bilinear(m.emission_texture, uv, true).rgb;
-        }
-        radiance += emitted;
-    }
-    if (probes.bounces != 0u) {
-        vec2 at = lightmap_uv(hit.x, bary);
-        if (at.x >= 0.0) {
-            radiance += albedo * textureLod(previous_lightmap, at, 0.0).rgb;
-        }
+    vec3 radiance = albedo / PI * irradiance + vec3(unpackHalf2x16(b.z), unpackHalf2x16(b.w).x);
+    if (probes.bounces != 0u && b.y != NO_LIGHTMAP_UV) {
+        radiance += albedo * textureLod(previous_lightmap, unpackUnorm2x16(b.y), 0.0).rgb;
     }
     return radiance;
 }
@@ -87,14 +64,13 @@ vec3 radiance_along(uvec4 hit, vec3 origin) {
 void main() {
     uint probe = gl_WorkGroupID.x;
     uint lane = gl_LocalInvocationID.x;
-    vec3 origin = texelFetch(probe_positions, int(probe)).xyz;
     vec3 sums[COEFFICIENTS];
     for (uint j = 0u; j < COEFFICIENTS; j++) {
         sums[j] = vec3(0.0);
     }
     uint first = probe * probes.rays_per_probe;
     for (uint ray = lane; ray < probes.rays_per_probe; ray += PROBE_GROUP_SIZE) {
-        vec3 l = radiance_along(texelFetch(probe_hits, int(first + ray)), origin);
+        vec3 l = radiance_along(first + ray);
         if (all(equal(l, vec3(0.0)))) {
             continue;
         }

@@ -6,6 +6,7 @@ use anyhow::{bail, Result};
 use clap::Args;
 
 use super::BakeSettings;
+use crate::scene::GiOverrides;
 
 #[derive(Args, Debug, Clone, Default)]
 pub struct ProbeArgs {
@@ -31,7 +32,7 @@ pub struct ProbeArgs {
     #[arg(long)]
     pub receiver_rays: Option<u32>,
     /// The highest spherical-harmonic band the probes store, 0 to 7: (N + 1)²
-    /// coefficients [default: 3].
+    /// coefficients [default: 7].
     #[arg(long)]
     pub sh_order: Option<u32>,
     /// The bake's file [default: in the user's cache folder,
@@ -39,6 +40,11 @@ pub struct ProbeArgs {
     /// settings].
     #[arg(long)]
     pub bake_file: Option<PathBuf>,
+    /// `--gi probes`: light bounces the first frame computes, 1 to 64 (1: no bounce
+    /// between surfaces after the first; with more, every later frame adds one)
+    /// [default: 8].
+    #[arg(long)]
+    pub probe_bounces: Option<u32>,
 }
 
 impl ProbeArgs {
@@ -52,22 +58,30 @@ impl ProbeArgs {
             (self.receiver_rays.is_some(), "--receiver-rays"),
             (self.sh_order.is_some(), "--sh-order"),
             (self.bake_file.is_some(), "--bake-file"),
+            (self.probe_bounces.is_some(), "--probe-bounces"),
         ]
         .into_iter()
         .filter_map(|(set, flag)| set.then_some(flag))
         .collect()
     }
 
-    /// The bake's settings: the command line over the defaults.
-    pub fn settings(&self) -> Result<BakeSettings> {
+    /// The bake's settings: the command line over the scene file's `[gi]` over the
+    /// defaults.
+    pub fn settings(&self, scene: &GiOverrides) -> Result<BakeSettings> {
         let d = BakeSettings::default();
         let settings = BakeSettings {
-            lightmap_size: self.lightmap_size.unwrap_or(d.lightmap_size),
-            probes: self.probes.unwrap_or(d.probes),
-            overlaps: self.overlaps.unwrap_or(d.overlaps),
-            probe_side: self.probe_side.unwrap_or(d.probe_side),
-            receiver_rays: self.receiver_rays.unwrap_or(d.receiver_rays),
-            sh_order: self.sh_order.unwrap_or(d.sh_order),
+            lightmap_size: self
+                .lightmap_size
+                .or(scene.lightmap_size)
+                .unwrap_or(d.lightmap_size),
+            probes: self.probes.or(scene.probes).unwrap_or(d.probes),
+            overlaps: self.overlaps.or(scene.overlaps).unwrap_or(d.overlaps),
+            probe_side: self.probe_side.or(scene.probe_side).unwrap_or(d.probe_side),
+            receiver_rays: self
+                .receiver_rays
+                .or(scene.receiver_rays)
+                .unwrap_or(d.receiver_rays),
+            sh_order: self.sh_order.or(scene.sh_order).unwrap_or(d.sh_order),
         };
         if !(16..=16384).contains(&settings.lightmap_size) {
             bail!(

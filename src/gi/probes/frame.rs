@@ -43,9 +43,11 @@ pub struct ProbeSettings {
     pub bake: BakeSettings,
     /// The bake's file; `None`: the user's cache folder ([`super::file::default_path`]).
     pub bake_file: Option<PathBuf>,
-    /// Each frame's relight adds last frame's lightmap (one bounce more per frame); off:
-    /// the lightmap holds the first bounce only.
-    pub bounces: bool,
+    /// Light bounces the first frame computes (1: the light that reaches a surface from
+    /// the emitters, lights and sky by one bounce off the probes' surfaces). With more
+    /// than one, every later frame adds one more on top of the last frame's lightmap, so
+    /// the bounces converge as a geometric series.
+    pub bounces: u32,
 }
 
 impl Default for ProbeSettings {
@@ -53,10 +55,33 @@ impl Default for ProbeSettings {
         Self {
             bake: BakeSettings::default(),
             bake_file: None,
-            bounces: true,
+            bounces: 8,
         }
     }
 }
+
+impl ProbeSettings {
+    /// Checks the frame's settings (the bake's are checked as they are parsed); errors
+    /// name the command-line option.
+    pub fn check(&self) -> Result<()> {
+        if !(1..=MAX_BOUNCES).contains(&self.bounces) {
+            bail!(
+                "--probe-bounces {}: give 1 to {MAX_BOUNCES} bounces",
+                self.bounces
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The debug views the probes offer.
+pub const DEBUG_VIEWS: [DebugView; 5] = [
+    DebugView::None,
+    DebugView::Indirect,
+    DebugView::Lightmap,
+    DebugView::Clusters,
+    DebugView::Probes,
+];
 
 /// The format of the lightmaps: irradiance / π, HDR.
 const LIGHTMAP_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -72,10 +97,8 @@ pub(super) const LIGHTMAP_USE: ImageUse = ImageUse {
     ),
 };
 
-/// Bounces the first frame computes (relight, basis and receivers once per bounce, each
-/// reading the lightmap the last wrote), as the cone tracer's first frame computes its
-/// voxel bounces; every later frame adds one on top of the last frame's lightmap.
-const FIRST_FRAME_BOUNCES: u32 = 8;
+/// The most bounces a first frame computes.
+pub const MAX_BOUNCES: u32 = 64;
 
 /// The most workgroups of one dispatch along x that every device runs.
 const MAX_GROUPS: u32 = 65535;
@@ -90,6 +113,8 @@ struct Tables {
     /// The receivers' coordinates, then their sky factors.
     coordinates: Vec<f32>,
     corner_uvs: Vec<[f32; 2]>,
+    /// Per lightmap texel, its receiver's cluster (`RAY_NONE`: none).
+    texel_clusters: Vec<u32>,
     uniforms: ProbeUniforms,
 }
 
@@ -172,6 +197,11 @@ impl Tables {
                 ]
             })
             .collect();
+        let [width, height] = data.lightmap;
+        let mut texel_clusters = vec![RAY_NONE; (width * height) as usize];
+        for (&[x, y], &c) in data.receiver_texels.iter().zip(&data.receiver_clusters) {
+            texel_clusters[(y * width + x) as usize] = c;
+        }
         let mut coordinates = data.coordinates.clone();
         coordinates.extend_from_slice(&data.receiver_sky);
         let uniforms = ProbeUniforms {
@@ -182,7 +212,7 @@ impl Tables {
             vector_count: vectors.len() as u32,
             sky_offset: data.coordinates.len() as u32,
             bounces: 1,
-            pad0: 0,
+            debug_radius: 0.0,
         };
         Ok(Self {
             hits,
@@ -196,6 +226,7 @@ impl Tables {
             receivers,
             coordinates,
             corner_uvs,
+            texel_clusters,
             uniforms,
         })
     }
@@ -203,7 +234,6 @@ impl Tables {
 
 /// The bake's tables on the GPU.
 struct Uploaded {
-    hits: TexelBuffer,
     harmonics: TexelBuffer,
     positions: TexelBuffer,
     vectors: TexelBuffer,
@@ -212,6 +242,7 @@ struct Uploaded {
     receivers: TexelBuffer,
     coordinates: TexelBuffer,
     corner_uvs: TexelBuffer,
+    texel_clusters: TexelBuffer,
 }
 
 impl Uploaded {
@@ -222,12 +253,6 @@ impl Uploaded {
             texel_buffer(ctx, &one_shot, name, format, texel, bytes)
         };
         Ok(Self {
-            hits: upload(
-                "probe hits",
-                F::R32G32B32A32_UINT,
-                16,
-                bytemuck::cast_slice(&tables.hits),
-            )?,
             harmonics: upload(
                 "probe ray harmonics",
                 F::R32_SFLOAT,
@@ -276,6 +301,12 @@ impl Uploaded {
                 8,
                 bytemuck::cast_slice(&tables.corner_uvs),
             )?,
+            texel_clusters: upload(
+                "probe texel clusters",
+                F::R32_UINT,
+                4,
+                bytemuck::cast_slice(&tables.texel_clusters),
+            )?,
         })
     }
 
@@ -283,7 +314,7 @@ impl Uploaded {
         vec![
             (
                 "probe_rays",
-                self.hits.buffer.size + self.harmonics.buffer.size + self.positions.buffer.size,
+                self.harmonics.buffer.size + self.positions.buffer.size,
             ),
             (
                 "probe_clusters",
@@ -296,6 +327,7 @@ impl Uploaded {
                 self.receivers.buffer.size + self.coordinates.buffer.size,
             ),
             ("probe_lightmap_uvs", self.corner_uvs.buffer.size),
+            ("probe_texel_clusters", self.texel_clusters.buffer.size),
         ]
     }
 }
@@ -304,6 +336,9 @@ impl Uploaded {
 pub struct ProbeGi {
     surfaces: SceneTriangles,
     tables: Uploaded,
+    /// What each probe ray met: the bake's hits and their surfaces (`probe_surfaces`).
+    hits: TexelBuffer,
+    hit_surfaces: TexelBuffer,
     uniforms: Buffer,
     lambda: Buffer,
     basis: Buffer,
@@ -323,8 +358,12 @@ pub struct ProbeGi {
     next: usize,
     /// The lightmaps are cleared before the next frame (after a restart).
     clear: bool,
-    /// Relight iterations the next frame runs.
+    /// Relight iterations the next frame runs: a bounce each (relight, basis and receivers,
+    /// each reading the lightmap the last wrote), as the cone tracer's first frame
+    /// computes its voxel bounces.
     iterations: u32,
+    /// Those of a first frame.
+    bounces: u32,
     report: BakeReport,
     origin: Origin,
     /// Reading or baking, and uploading, in milliseconds.
@@ -336,6 +375,7 @@ pub struct ProbeGi {
 
 impl ProbeGi {
     pub fn new(inputs: &Inputs, settings: &ProbeSettings) -> Result<Self> {
+        settings.check()?;
         let ctx = inputs.ctx;
         if !ctx.features.geometry_shader {
             bail!(
@@ -363,7 +403,9 @@ impl ProbeGi {
         }
         let tables = Tables::new(scene, data)?;
         let counts = ProbeUniforms {
-            bounces: u32::from(settings.bounces),
+            bounces: u32::from(settings.bounces > 1),
+            // A tenth of the probes' spacing keeps their spheres apart on the screen.
+            debug_radius: 0.1 * bake.report.probe_spacing,
             ..tables.uniforms
         };
         if counts.probe_count > MAX_GROUPS {
@@ -374,6 +416,35 @@ impl ProbeGi {
         }
         let surfaces = SceneTriangles::new(ctx, scene)?;
         let uploaded = Uploaded::new(ctx, &tables, data)?;
+        // Read once, by `probe_surfaces`; kept while the sets refer to it.
+        let hits = texel_buffer(
+            ctx,
+            &OneShot::new(ctx)?,
+            "probe hits",
+            vk::Format::R32G32B32A32_UINT,
+            16,
+            bytemuck::cast_slice(&tables.hits),
+        )?;
+        let rays = u64::from(counts.probe_count) * u64::from(counts.rays_per_probe);
+        let texel_limit = u64::from(ctx.properties.limits.max_texel_buffer_elements);
+        if 2 * rays > texel_limit {
+            bail!(
+                "the bake's {rays} probe rays need {} texels, more than the {texel_limit} this \
+                 device binds in one texel buffer: bake fewer --probes or a smaller --probe-side",
+                2 * rays
+            );
+        }
+        let hit_surfaces = TexelBuffer::new(
+            "probe surfaces",
+            Buffer::new(
+                ctx,
+                "probe surfaces",
+                (32 * rays).max(32),
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
+                MemoryLocation::GpuOnly,
+            )?,
+            vk::Format::R32G32B32A32_UINT,
+        )?;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let vec4 = 16u64;
         let lambda = Buffer::new(
@@ -459,6 +530,13 @@ impl ProbeGi {
             Binding::new(layout::BINDING_PROBE_LIGHTMAP_PREVIOUS, sampled, compute),
             Binding::new(layout::BINDING_PROBE_CORNER_UVS, texels, compute),
             Binding::new(layout::BINDING_PROBE_POSITIONS, texels, compute),
+            Binding::new(
+                layout::BINDING_PROBE_SURFACES,
+                vk::DescriptorType::STORAGE_BUFFER,
+                compute,
+            ),
+            Binding::new(layout::BINDING_PROBE_SURFACES_READ, texels, compute),
+            Binding::new(layout::BINDING_PROBE_TEXEL_CLUSTERS, texels, compute),
         ]);
         let descriptor_sets = DescriptorSets::new(ctx, "probes", &bindings, 2)?;
         let sets = [
@@ -477,7 +555,13 @@ impl ProbeGi {
                 )
                 .buffer(layout::BINDING_PROBE_LAMBDA, storage_buffer, lambda.raw)
                 .buffer(layout::BINDING_PROBE_BASIS, storage_buffer, basis.raw)
-                .texel_buffer(layout::BINDING_PROBE_HITS, t.hits.view())
+                .texel_buffer(layout::BINDING_PROBE_HITS, hits.view())
+                .buffer(
+                    layout::BINDING_PROBE_SURFACES,
+                    storage_buffer,
+                    hit_surfaces.buffer.raw,
+                )
+                .texel_buffer(layout::BINDING_PROBE_SURFACES_READ, hit_surfaces.view())
                 .texel_buffer(layout::BINDING_PROBE_SH, t.harmonics.view())
                 .texel_buffer(layout::BINDING_PROBE_VECTORS, t.vectors.view())
                 .texel_buffer(
@@ -489,6 +573,10 @@ impl ProbeGi {
                 .texel_buffer(layout::BINDING_PROBE_COORDINATES, t.coordinates.view())
                 .texel_buffer(layout::BINDING_PROBE_CORNER_UVS, t.corner_uvs.view())
                 .texel_buffer(layout::BINDING_PROBE_POSITIONS, t.positions.view())
+                .texel_buffer(
+                    layout::BINDING_PROBE_TEXEL_CLUSTERS,
+                    t.texel_clusters.view(),
+                )
                 .storage_image(layout::BINDING_PROBE_LIGHTMAP, lightmaps[i].view)
                 .sampled_image(
                     layout::BINDING_PROBE_LIGHTMAP_SAMPLED,
@@ -515,6 +603,17 @@ impl ProbeGi {
         let basis_pass = pipeline("probe_basis", s::GI_PROBES_BASIS_COMP, &coefficients)?;
         let receivers = pipeline("probe_receivers", s::GI_PROBES_RECEIVERS_COMP, &[])?;
         let gather = pipeline("probe_gather", s::GI_PROBES_GATHER_COMP, &[])?;
+        let decode = pipeline("probe_surfaces", s::GI_PROBES_SURFACES_COMP, &[])?;
+        OneShot::new(ctx)?.run("probe_surfaces", |cmd| {
+            let groups = rays.div_ceil(u64::from(layout::PROBE_GROUP_SIZE));
+            let x = groups.min(u64::from(MAX_GROUPS));
+            decode.dispatch(
+                cmd,
+                &[(layout::SET_GI, sets[0])],
+                [x as u32, groups.div_ceil(x) as u32, 1],
+            );
+            Ok(())
+        })?;
         let prepare_ms = start.elapsed().as_secs_f64() * 1e3;
         log::info!(
             "irradiance probes: {} probes, {} receivers, {} clusters, {} basis vectors, \
@@ -533,6 +632,8 @@ impl ProbeGi {
         Ok(Self {
             surfaces,
             tables: uploaded,
+            hits,
+            hit_surfaces,
             uniforms,
             lambda,
             basis,
@@ -547,11 +648,8 @@ impl ProbeGi {
             counts,
             next: 0,
             clear: false,
-            iterations: if settings.bounces {
-                FIRST_FRAME_BOUNCES
-            } else {
-                1
-            },
+            iterations: settings.bounces,
+            bounces: settings.bounces,
             report: bake.report,
             origin: bake.origin,
             prepare_ms,
@@ -627,13 +725,14 @@ impl Technique for ProbeGi {
         Ok(())
     }
 
+    /// The indirect term; or, in a debug view of the probes' own, the screen radiance.
     fn record_gather(
         &self,
         cmd: vk::CommandBuffer,
         timer: &mut crate::vk::GpuTimer,
         frame_set: vk::DescriptorSet,
         screen: &Screen,
-        _options: &GatherOptions,
+        options: &GatherOptions,
     ) -> Gathered {
         timer.begin(cmd, "probe_gather");
         let sets = [
@@ -647,14 +746,15 @@ impl Technique for ProbeGi {
             groups_2d(screen.reduced_extent(), layout::SCREEN_GROUP_SIZE),
         );
         timer.end(cmd);
-        Gathered::Terms
+        match options.debug_view {
+            DebugView::Lightmap | DebugView::Clusters | DebugView::Probes => Gathered::Screen,
+            _ => Gathered::Terms,
+        }
     }
 
     fn restart(&mut self) {
         self.clear = true;
-        if self.counts.bounces != 0 {
-            self.iterations = FIRST_FRAME_BOUNCES;
-        }
+        self.iterations = self.bounces;
     }
 
     fn shades_direct(&self) -> bool {
@@ -664,6 +764,10 @@ impl Technique for ProbeGi {
     fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
         let mut bytes = self.surfaces.memory_bytes();
         bytes.extend(self.tables.memory_bytes());
+        bytes.push((
+            "probe_ray_hits",
+            self.hits.buffer.size + self.hit_surfaces.buffer.size,
+        ));
         bytes.push((
             "probe_lambda_and_basis",
             self.lambda.size + self.basis.size + self.uniforms.size,
@@ -711,7 +815,7 @@ impl Technique for ProbeGi {
     }
 
     fn debug_views(&self) -> &'static [DebugView] {
-        &[DebugView::None, DebugView::Indirect]
+        &DEBUG_VIEWS
     }
 
     fn debug_levels(&self) -> u32 {

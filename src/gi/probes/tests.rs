@@ -615,7 +615,7 @@ fn the_frames_lightmap_matches_the_host_twin() {
             sh_order: 3,
         },
         bake_file: Some(bake_file.clone()),
-        bounces: false,
+        bounces: 1,
     };
     let render = crate::settings::RenderSettings {
         gi: crate::gi::GiSettings::Probes(settings.clone()),
