@@ -23,8 +23,8 @@ const SMALL_BAKE: &[&str] = &[
 
 /// The white furnace: a closed box of albedo a emitting L everywhere shows L / (1 - a) at
 /// every pixel once the bounces have converged (64 bounces leave 0.8^64 of the series),
-/// within 2 % (measured 0.24 % and 0.46 %; the probes' transport reconstructs a constant
-/// radiance within 1.6 % at the bake's test settings). Albedo 0.8 puts four
+/// within 4 % (measured 1.9 % and 2.5 % at the default PCA bound, 0.05, whose truncation
+/// error is local, of zero mean; 0.24 % and 0.46 % with the thesis's 0.005). Albedo 0.8 puts four
 /// fifths of the image in the bounces: the relight's albedo, the lightmap's reads and
 /// writes and the gather all count.
 #[test]
@@ -60,7 +60,7 @@ fn furnace_gives_the_geometric_series_at_every_pixel() {
             100.0 * worst
         );
         assert!(
-            worst <= 0.02,
+            worst <= 0.04,
             "a pixel {:.2} % off L / (1 - a)",
             100.0 * worst
         );

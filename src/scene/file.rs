@@ -67,6 +67,8 @@
 //! probe_side = 64                # --probe-side
 //! receiver_rays = 64             # --receiver-rays
 //! sh_order = 7                   # --sh-order
+//! pca_error = 0.005              # --pca-error
+//! max_basis = 32                 # --max-basis
 //! probe_bounces = 8              # --probe-bounces (--gi probes)
 //! ```
 //!

@@ -218,6 +218,9 @@ pub struct GiOverrides {
     pub probe_side: Option<u32>,
     pub receiver_rays: Option<u32>,
     pub sh_order: Option<u32>,
+    /// The irradiance probes' clustered PCA: error bound and most basis vectors.
+    pub pca_error: Option<f32>,
+    pub max_basis: Option<u32>,
     /// The irradiance probes' bounces in a first frame.
     pub probe_bounces: Option<u32>,
 }

@@ -35,6 +35,14 @@ pub struct ProbeArgs {
     /// coefficients [default: 7].
     #[arg(long)]
     pub sh_order: Option<u32>,
+    /// The clustered PCA's bound on each cluster's projection error, Sedláček's
+    /// 1 − √(Σ_{i≤k} σ_i / Σ σ_i), above 0 and below 1 [default: 0.05; the thesis's
+    /// 0.005 keeps the transport's sampling noise].
+    #[arg(long)]
+    pub pca_error: Option<f32>,
+    /// The most basis vectors a cluster keeps, 1 to 256 [default: 32].
+    #[arg(long)]
+    pub max_basis: Option<u32>,
     /// The bake's file [default: in the user's cache folder,
     /// $XDG_CACHE_HOME/voxcone/bakes or ~/.cache/voxcone/bakes, one per scene file and
     /// settings].
@@ -57,6 +65,8 @@ impl ProbeArgs {
             (self.probe_side.is_some(), "--probe-side"),
             (self.receiver_rays.is_some(), "--receiver-rays"),
             (self.sh_order.is_some(), "--sh-order"),
+            (self.pca_error.is_some(), "--pca-error"),
+            (self.max_basis.is_some(), "--max-basis"),
             (self.bake_file.is_some(), "--bake-file"),
             (self.probe_bounces.is_some(), "--probe-bounces"),
         ]
@@ -82,7 +92,21 @@ impl ProbeArgs {
                 .or(scene.receiver_rays)
                 .unwrap_or(d.receiver_rays),
             sh_order: self.sh_order.or(scene.sh_order).unwrap_or(d.sh_order),
+            pca_error: self.pca_error.or(scene.pca_error).unwrap_or(d.pca_error),
+            max_basis: self.max_basis.or(scene.max_basis).unwrap_or(d.max_basis),
         };
+        if !(settings.pca_error > 0.0 && settings.pca_error < 1.0) {
+            bail!(
+                "--pca-error {}: the clusters' projection error bound lies above 0 and below 1",
+                settings.pca_error
+            );
+        }
+        if !(1..=256).contains(&settings.max_basis) {
+            bail!(
+                "--max-basis {}: a cluster keeps 1 to 256 basis vectors",
+                settings.max_basis
+            );
+        }
         if !(16..=16384).contains(&settings.lightmap_size) {
             bail!(
                 "--lightmap-size {}: the lightmap must be 16 to 16384 texels wide",

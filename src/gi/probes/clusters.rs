@@ -29,6 +29,7 @@ pub struct ClusterSettings {
     pub max_basis: usize,
 }
 
+/// The thesis's bounds (the bake's own error bound is looser: `BakeSettings::pca_error`).
 impl Default for ClusterSettings {
     fn default() -> Self {
         Self {

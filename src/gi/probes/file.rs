@@ -72,6 +72,8 @@ pub fn content_key(scene: &Scene, settings: &BakeSettings) -> u128 {
         settings.probe_side,
         settings.receiver_rays,
         settings.sh_order,
+        settings.pca_error.to_bits(),
+        settings.max_basis,
     ] {
         h.update(&v.to_le_bytes());
     }

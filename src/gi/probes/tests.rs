@@ -470,6 +470,7 @@ fn bake_file_round_trips_and_rejects_damage() {
         probe_side: 16,
         receiver_rays: 16,
         sh_order: 2,
+        ..BakeSettings::default()
     };
     let path = dir.0.join("cornell.bake");
     let bake =
@@ -613,6 +614,7 @@ fn the_frames_lightmap_matches_the_host_twin() {
             probe_side: 32,
             receiver_rays: 32,
             sh_order: 3,
+            ..super::BakeSettings::default()
         },
         bake_file: Some(bake_file.clone()),
         bounces: 1,
