@@ -120,8 +120,9 @@ struct Tables {
 
 impl Tables {
     /// The tables of `data`, baked from the static meshes of `scene`: its triangles are
-    /// renumbered from the static scene's order to the whole scene's.
-    fn new(scene: &Scene, data: &BakeData) -> Result<Self> {
+    /// renumbered from the static scene's order to the whole scene's. `bounces`: the
+    /// relight adds last frame's lightmap; `debug_radius`: the probes' spheres' radius.
+    fn new(scene: &Scene, data: &BakeData, bounces: bool, debug_radius: f32) -> Result<Self> {
         let n = super::sh::coefficient_count(data.sh_order);
         // The whole scene's index of each static triangle, and the corners' lightmap uvs
         // of every triangle (moving meshes' negative: none).
@@ -211,8 +212,8 @@ impl Tables {
             receiver_count: data.receiver_texels.len() as u32,
             vector_count: vectors.len() as u32,
             sky_offset: data.coordinates.len() as u32,
-            bounces: 1,
-            debug_radius: 0.0,
+            bounces: u32::from(bounces),
+            debug_radius,
         };
         Ok(Self {
             hits,
@@ -401,13 +402,14 @@ impl ProbeGi {
                 ctx.device_name()
             );
         }
-        let tables = Tables::new(scene, data)?;
-        let counts = ProbeUniforms {
-            bounces: u32::from(settings.bounces > 1),
-            // A tenth of the probes' spacing keeps their spheres apart on the screen.
-            debug_radius: 0.1 * bake.report.probe_spacing,
-            ..tables.uniforms
-        };
+        // A tenth of the probes' spacing keeps their spheres apart on the screen.
+        let tables = Tables::new(
+            scene,
+            data,
+            settings.bounces > 1,
+            0.1 * bake.report.probe_spacing,
+        )?;
+        let counts = tables.uniforms;
         if counts.probe_count > MAX_GROUPS {
             bail!(
                 "the bake has {} probes: the relight runs a workgroup per probe, {MAX_GROUPS} at most",
