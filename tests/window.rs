@@ -4,7 +4,8 @@
 mod common;
 
 use std::ffi::OsStr;
-use std::process::{Command, Output};
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Output, Stdio};
 use std::sync::Mutex;
 
 use common::{assert_clean, stderr, temp_dir};
@@ -23,19 +24,68 @@ fn require(tool: &str, package: &str) {
 /// recreated its swapchain only 3 times.
 static ONE_WINDOW: Mutex<()> = Mutex::new(());
 
+/// An Xvfb server of its own, stopped on drop. `-displayfd` makes the server pick a free
+/// display and write its number only once it accepts connections: `xvfb-run -a` guesses
+/// the number from lock files and waits on a signal, and under load its viewer once found
+/// no server (CI, "Failed to open connection to X server").
+struct VirtualScreen {
+    server: Child,
+    display: String,
+}
+
+impl VirtualScreen {
+    fn start() -> Self {
+        require("Xvfb", "xvfb");
+        let mut server = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "1024x768x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("starting Xvfb");
+        let mut number = String::new();
+        BufReader::new(server.stdout.take().expect("Xvfb's stdout"))
+            .read_line(&mut number)
+            .expect("reading Xvfb's display number");
+        let number = number.trim();
+        assert!(
+            !number.is_empty() && number.bytes().all(|b| b.is_ascii_digit()),
+            "Xvfb reported no display ({number:?}); did it fail to start?"
+        );
+        let display = format!(":{number}");
+        Self { server, display }
+    }
+}
+
+impl Drop for VirtualScreen {
+    fn drop(&mut self) {
+        let _ = self.server.kill();
+        let _ = self.server.wait();
+    }
+}
+
 /// Runs `program` with `args` in a virtual screen, validation on, and checks it clean.
 fn under_xvfb(program: &OsStr, args: &[&OsStr]) -> Output {
-    require("xvfb-run", "xvfb xauth");
     // A failed test poisons the lock; the next may still run.
     let _one = ONE_WINDOW.lock().unwrap_or_else(|e| e.into_inner());
-    let output = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1024x768x24"])
-        .arg(program)
+    let screen = VirtualScreen::start();
+    let output = Command::new(program)
         .args(args)
+        .env("DISPLAY", &screen.display)
+        .env_remove("WAYLAND_DISPLAY")
         .env("VOXCONE_VALIDATION", "1")
         .env("RUST_LOG", "info")
         .output()
-        .expect("running xvfb-run");
+        .expect("running the program under Xvfb");
+    drop(screen);
     eprintln!("{}", stderr(&output));
     assert_clean(&output);
     output
