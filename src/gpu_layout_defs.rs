@@ -383,6 +383,16 @@ gpu_layout! {
         /// Irradiance probes (set 3): each lightmap texel's receiver's cluster (`RAY_NONE`: no
         /// receiver), a `usamplerBuffer` of one index each, row by row (the clusters' debug view).
         BINDING_PROBE_TEXEL_CLUSTERS = 25;
+        /// Irradiance probes (set 3): the grid of spatial receivers' irradiance / π, an
+        /// `rgba16f` 3D storage image of the grid's points, its six directions' slabs one above
+        /// the other along z (`gi::probes::grid::DIRECTIONS`).
+        BINDING_PROBE_GRID = 26;
+        /// Irradiance probes (set 3): the same image sampled (linear, clamped to the edge).
+        BINDING_PROBE_GRID_SAMPLED = 27;
+        /// Irradiance probes (set 3): what this frame computes of the grid, `uint[]` storage
+        /// buffer: the count of the spatial clusters' basis vectors listed, the count of the
+        /// spatial receivers listed, then the vectors' indices and the receivers'.
+        BINDING_PROBE_GRID_ACTIVE = 28;
         /// Workgroup size of the probe passes.
         PROBE_GROUP_SIZE = 64;
 
@@ -808,7 +818,7 @@ gpu_layout! {
         uint coefficients,
         /// Receivers.
         uint receiver_count,
-        /// Basis vectors of all clusters together.
+        /// Basis vectors of the lightmap's clusters (the grid's follow them).
         uint vector_count,
         /// Where the receivers' sky factors start in `BINDING_PROBE_COORDINATES`.
         uint sky_offset,
@@ -816,6 +826,12 @@ gpu_layout! {
         uint bounces,
         /// The radius of the spheres the probes' debug view draws, in world units.
         float debug_radius,
+        /// The grid of spatial receivers: its points along x, y and z, and their count (0: no grid); the receivers of direction d and point p are receiver `receiver_count + d * grid_size.w + p`.
+        uvec4 grid_size,
+        /// The grid's box's least corner (xyz).
+        vec4 grid_min,
+        /// One over the grid's box's extent (xyz; 0 along a flat axis).
+        vec4 grid_inverse_extent,
     }
 
     /// Push constants of every mesh draw.

@@ -258,6 +258,18 @@ fn bad_probe_settings() {
             "render",
             "--gi",
             "probes",
+            "--spatial-receivers",
+            "300000",
+            "-o",
+            "x.png",
+        ],
+        &["--spatial-receivers 300000", "0 to 262144"],
+    );
+    assert_fails_naming(
+        &[
+            "render",
+            "--gi",
+            "probes",
             "--debug-view",
             "voxel-albedo",
             "-o",

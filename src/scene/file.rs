@@ -69,6 +69,7 @@
 //! sh_order = 7                   # --sh-order
 //! pca_error = 0.005              # --pca-error
 //! max_basis = 32                 # --max-basis
+//! spatial_receivers = 2048       # --spatial-receivers
 //! probe_bounces = 8              # --probe-bounces (--gi probes)
 //! ```
 //!

@@ -221,6 +221,8 @@ pub struct GiOverrides {
     /// The irradiance probes' clustered PCA: error bound and most basis vectors.
     pub pca_error: Option<f32>,
     pub max_basis: Option<u32>,
+    /// The irradiance probes' grid for moving meshes: the desired spatial receivers.
+    pub spatial_receivers: Option<u32>,
     /// The irradiance probes' bounces in a first frame.
     pub probe_bounces: Option<u32>,
 }

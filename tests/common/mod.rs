@@ -101,3 +101,48 @@ pub fn furnace(dir: &Path, walls: &str, extra: &str) -> PathBuf {
     std::fs::write(&scene, format!("[[mesh]]\npath = \"box.obj\"\n{extra}")).unwrap();
     scene
 }
+
+/// A unit sphere (a UV sphere of 24 × 48 quads, smooth normals) as `name.obj` in `dir`,
+/// its one material `ball` with the MTL statements `material`, for a scene to place.
+pub fn sphere(dir: &Path, name: &str, material: &str) {
+    use std::f32::consts::PI;
+    use std::fmt::Write;
+    let (rings, segments) = (24usize, 48usize);
+    let mut obj = format!("mtllib {name}.mtl\nusemtl ball\n");
+    for i in 0..=rings {
+        let theta = PI * i as f32 / rings as f32;
+        for j in 0..=segments {
+            let phi = 2.0 * PI * j as f32 / segments as f32;
+            let p = [
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            ];
+            writeln!(
+                obj,
+                "v {} {} {}\nvn {} {} {}",
+                p[0], p[1], p[2], p[0], p[1], p[2]
+            )
+            .unwrap();
+        }
+    }
+    let at = |i: usize, j: usize| i * (segments + 1) + j + 1;
+    for i in 0..rings {
+        for j in 0..segments {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            // Wound outwards; the poles' degenerate halves left out.
+            if i > 0 {
+                writeln!(obj, "f {a}//{a} {d}//{d} {b}//{b}").unwrap();
+            }
+            if i + 1 < rings {
+                writeln!(obj, "f {b}//{b} {d}//{d} {c}//{c}").unwrap();
+            }
+        }
+    }
+    std::fs::write(dir.join(format!("{name}.obj")), obj).unwrap();
+    std::fs::write(
+        dir.join(format!("{name}.mtl")),
+        format!("newmtl ball\n{material}"),
+    )
+    .unwrap();
+}

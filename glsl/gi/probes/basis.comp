@@ -1,6 +1,8 @@
 #version 460
 // The clusters' basis vectors (Sedláček 2019, 3.3.1.3), an invocation per vector: row i
 // of a cluster's (Σ V^T)_k times its probes' harmonics stacked, b_i = Σ_p Σ_j P_i,pj λ_pj.
+// Every vector of the lightmap's clusters, then those of the grid's clusters the host
+// listed this frame (4.2.3: only the grid near moving meshes is computed).
 #include "gi/probes/probes.glsl"
 
 layout(local_size_x = PROBE_GROUP_SIZE) in;
@@ -15,11 +17,18 @@ layout(set = SET_GI, binding = BINDING_PROBE_LAMBDA, std430) readonly buffer Lam
 layout(set = SET_GI, binding = BINDING_PROBE_BASIS, std430) writeonly buffer BasisBlock {
     vec4 basis[];
 };
+layout(set = SET_GI, binding = BINDING_PROBE_GRID_ACTIVE, std430) readonly buffer ActiveBlock {
+    uint grid_active[];
+};
 
 void main() {
     uint v = gl_GlobalInvocationID.x;
     if (v >= probes.vector_count) {
-        return;
+        uint listed = v - probes.vector_count;
+        if (listed >= grid_active[GRID_ACTIVE_VECTORS]) {
+            return;
+        }
+        v = grid_active[GRID_ACTIVE_LIST + listed];
     }
     uvec4 vector = texelFetch(vectors, int(v));
     vec3 b = vec3(0.0);

@@ -2,8 +2,9 @@
 // The probes' gather (Sedláček 2019, 3.3.2): at each reduced-resolution pixel, the
 // lightmap read bilinearly at the uv of the G-buffer's triangle there. The receivers
 // cover every texel a chart's bilinear footprint reaches (`receivers.rs`), so no seam
-// reads an empty texel. Moving meshes have no lightmap: they get no indirect light
-// here. The probes' own debug views write the screen radiance instead (at scale 1, each
+// reads an empty texel. Moving meshes have no lightmap: they read the grid of spatial
+// receivers (4.1.2) at their position, its six directions weighted by the normal. The
+// probes' own debug views write the screen radiance instead (at scale 1, each
 // reduced-resolution pixel is a pixel).
 #include "gi/screen/screen.glsl"
 #include "gi/probes/probes.glsl"
@@ -11,6 +12,7 @@
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_INDIRECT, rgba16f) uniform writeonly image2D indirect;
 layout(set = SET_GI, binding = BINDING_PROBE_LIGHTMAP_SAMPLED) uniform sampler2D lightmap;
+layout(set = SET_GI, binding = BINDING_PROBE_GRID_SAMPLED) uniform sampler3D grid;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_RADIANCE, rgba32f) uniform writeonly image2D screen_radiance;
 layout(set = SET_GI, binding = BINDING_PROBE_TEXEL_CLUSTERS) uniform usamplerBuffer texel_clusters;
 layout(set = SET_GI, binding = BINDING_PROBE_POSITIONS) uniform samplerBuffer probe_positions;
@@ -44,6 +46,21 @@ bool probe_on_ray(ivec2 pixel, float t_max, out vec3 radiance) {
         }
     }
     return nearest < t_max;
+}
+
+// The irradiance / π at a surface of unit normal n at p from the grid: each axis's slab
+// facing n read trilinearly (z clamped within the slab, x and y by the sampler), weighted
+// by n_a², the ambient cube of `grid.rs`.
+vec3 grid_irradiance(vec3 p, vec3 n) {
+    vec3 uvw = clamp((p - probes.grid_min.xyz) * probes.grid_inverse_extent.xyz, 0.0, 1.0);
+    float slab = float(probes.grid_size.z);
+    float z = clamp(uvw.z * slab, 0.5, slab - 0.5);
+    vec3 e = vec3(0.0);
+    for (int a = 0; a < 3; a++) {
+        float d = float(2 * a + (n[a] < 0.0 ? 1 : 0));
+        e += n[a] * n[a] * textureLod(grid, vec3(uvw.xy, (z + d * slab) / (6.0 * slab)), 0.0).rgb;
+    }
+    return e;
 }
 
 // Barycentrics of point p (on it, up to float error) in triangle `tri`.
@@ -97,6 +114,9 @@ void main() {
             } else {
                 debug = 0.5 * imageLoad(gbuffer_albedo, pixel).rgb * e;
             }
+        } else if (probes.grid_size.w > 0u) {
+            e = grid_irradiance(p, normalize(imageLoad(gbuffer_normal, pixel).xyz));
+            debug = frame.debug_view == DEBUG_LIGHTMAP ? e : 0.5 * imageLoad(gbuffer_albedo, pixel).rgb * e;
         }
     }
     if (frame.debug_view == DEBUG_PROBES) {

@@ -37,4 +37,30 @@ vec3 unpack_normal(uint packed) {
     n.xy += vec2(n.x >= 0.0 ? -t : t, n.y >= 0.0 ? -t : t);
     return normalize(n);
 }
+
+// The grid of spatial receivers' active lists (`BINDING_PROBE_GRID_ACTIVE`): the counts of
+// the vectors and of the receivers listed, then the vectors' indices and the receivers'.
+#define GRID_ACTIVE_VECTORS 0u
+#define GRID_ACTIVE_RECEIVERS 1u
+#define GRID_ACTIVE_LIST 2u
+
+#ifdef PROBE_RECEIVERS
+// A receiver's irradiance (Sedláček 2019, 3.3.1.3): its row of U_k times its cluster's
+// basis vectors, plus the sky it sees past every probe (the bake's sky factor × the sky's
+// radiance). Needs `common/frame.glsl`.
+layout(set = SET_GI, binding = BINDING_PROBE_RECEIVERS) uniform usamplerBuffer receivers;
+layout(set = SET_GI, binding = BINDING_PROBE_COORDINATES) uniform samplerBuffer coordinates;
+layout(set = SET_GI, binding = BINDING_PROBE_BASIS, std430) readonly buffer BasisBlock {
+    vec4 basis[];
+};
+
+vec3 receiver_irradiance(uint r) {
+    uvec4 receiver = texelFetch(receivers, int(r));
+    vec3 e = frame.sky_radiance.rgb * texelFetch(coordinates, int(probes.sky_offset + r)).r;
+    for (uint k = 0u; k < receiver.w; k++) {
+        e += texelFetch(coordinates, int(receiver.y + k)).r * basis[receiver.z + k].rgb;
+    }
+    return max(e, vec3(0.0));
+}
+#endif
 #endif

@@ -8,6 +8,9 @@ use clap::Args;
 use super::BakeSettings;
 use crate::scene::GiOverrides;
 
+/// The most points of the grid of spatial receivers.
+pub const MAX_SPATIAL_RECEIVERS: u32 = 262_144;
+
 #[derive(Args, Debug, Clone, Default)]
 pub struct ProbeArgs {
     /// Width and height of the lightmap page the receivers' atlas is fitted into, 16 to
@@ -43,6 +46,11 @@ pub struct ProbeArgs {
     /// The most basis vectors a cluster keeps, 1 to 256 [default: 32].
     #[arg(long)]
     pub max_basis: Option<u32>,
+    /// The desired points of the grid of spatial receivers (six directions each) that
+    /// shades moving meshes, 0 to 262144 (0: no grid; moving meshes get no indirect
+    /// light) [default: 2048].
+    #[arg(long)]
+    pub spatial_receivers: Option<u32>,
     /// The bake's file [default: in the user's cache folder,
     /// $XDG_CACHE_HOME/voxcone/bakes or ~/.cache/voxcone/bakes, one per scene file and
     /// settings].
@@ -67,6 +75,7 @@ impl ProbeArgs {
             (self.sh_order.is_some(), "--sh-order"),
             (self.pca_error.is_some(), "--pca-error"),
             (self.max_basis.is_some(), "--max-basis"),
+            (self.spatial_receivers.is_some(), "--spatial-receivers"),
             (self.bake_file.is_some(), "--bake-file"),
             (self.probe_bounces.is_some(), "--probe-bounces"),
         ]
@@ -94,7 +103,17 @@ impl ProbeArgs {
             sh_order: self.sh_order.or(scene.sh_order).unwrap_or(d.sh_order),
             pca_error: self.pca_error.or(scene.pca_error).unwrap_or(d.pca_error),
             max_basis: self.max_basis.or(scene.max_basis).unwrap_or(d.max_basis),
+            spatial_receivers: self
+                .spatial_receivers
+                .or(scene.spatial_receivers)
+                .unwrap_or(d.spatial_receivers),
         };
+        if settings.spatial_receivers > MAX_SPATIAL_RECEIVERS {
+            bail!(
+                "--spatial-receivers {}: the grid holds 0 to {MAX_SPATIAL_RECEIVERS} points",
+                settings.spatial_receivers
+            );
+        }
         if !(settings.pca_error > 0.0 && settings.pca_error < 1.0) {
             bail!(
                 "--pca-error {}: the clusters' projection error bound lies above 0 and below 1",

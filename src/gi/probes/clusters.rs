@@ -129,6 +129,19 @@ impl Clusters {
         out
     }
 
+    /// Adds `other`'s clusters, whose receivers follow this one's.
+    pub fn append(&mut self, other: Clusters) {
+        let (clusters, coordinates) = (self.list.len() as u32, self.coordinates.len() as u32);
+        self.cluster_of
+            .extend(other.cluster_of.iter().map(|c| c + clusters));
+        self.offsets
+            .extend(other.offsets.iter().map(|o| o + coordinates));
+        self.coordinates.extend(other.coordinates);
+        self.list.extend(other.list);
+        self.residual += other.residual;
+        self.energy += other.energy;
+    }
+
     /// Receiver `r`'s irradiance from the probes' `lambda` (probes × (order + 1)²) and a
     /// sky of radiance `sky`, through its cluster.
     pub fn irradiance(&self, transport: &Transport, lambda: &[Vec3], sky: Vec3, r: usize) -> Vec3 {

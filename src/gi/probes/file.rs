@@ -19,7 +19,7 @@ use crate::scene::Scene;
 
 const MAGIC: &[u8; 8] = b"VXCBAKE\0";
 /// Raised whenever the payload's sections or their meaning change.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 const HEADER: usize = 8 + 4 + 4 + 16 + 8 + 16;
 
 /// What a frame of `--gi probes` reads from a bake.
@@ -32,11 +32,17 @@ pub struct BakeData {
     pub mesh_corners: Vec<u32>,
     pub corner_uvs: Vec<[f32; 2]>,
     /// Per receiver: its texel, its cluster, where its row of U_k starts, its sky factor.
+    /// The lightmap's receivers come first, one per texel of `receiver_texels`; then the
+    /// grid's spatial receivers, direction after direction (`grid::DIRECTIONS`), each
+    /// direction's points in the grid's order.
     pub receiver_texels: Vec<[u32; 2]>,
     pub receiver_clusters: Vec<u32>,
     pub receiver_offsets: Vec<u32>,
     pub receiver_sky: Vec<f32>,
     pub coordinates: Vec<f32>,
+    /// The grid of spatial receivers: its points per axis (zero: no grid) and its box.
+    pub grid_size: [u32; 3],
+    pub grid_bounds: [[f32; 3]; 2],
     pub probes: Vec<[f32; 3]>,
     pub probe_side: u32,
     pub probe_hits: Vec<RayHit>,
@@ -74,6 +80,7 @@ pub fn content_key(scene: &Scene, settings: &BakeSettings) -> u128 {
         settings.sh_order,
         settings.pca_error.to_bits(),
         settings.max_basis,
+        settings.spatial_receivers,
     ] {
         h.update(&v.to_le_bytes());
     }
@@ -134,6 +141,8 @@ impl BakeData {
         section(&mut payload, &self.receiver_offsets);
         section(&mut payload, &self.receiver_sky);
         section(&mut payload, &self.coordinates);
+        section(&mut payload, &self.grid_size);
+        section(&mut payload, &self.grid_bounds);
         section(&mut payload, &self.probes);
         section(&mut payload, &self.probe_hits);
         section(&mut payload, &self.cluster_probe_starts);
@@ -231,7 +240,7 @@ impl BakeData {
         if lightmap.len() != 2 || orders.len() != 2 {
             bail!("the lightmap's size or the orders are malformed");
         }
-        Ok(Self {
+        let data = Self {
             lightmap: [lightmap[0], lightmap[1]],
             sh_order: orders[0],
             probe_side: orders[1],
@@ -242,6 +251,8 @@ impl BakeData {
             receiver_offsets: array(next()?)?,
             receiver_sky: array(next()?)?,
             coordinates: array(next()?)?,
+            grid_size: exactly(array(next()?)?, "the grid's size")?,
+            grid_bounds: exactly(array(next()?)?, "the grid's box")?,
             probes: array(next()?)?,
             probe_hits: array(next()?)?,
             cluster_probe_starts: array(next()?)?,
@@ -250,6 +261,29 @@ impl BakeData {
             cluster_projection_starts: array(next()?)?,
             projections: array(next()?)?,
             report: String::from_utf8(next()?.to_vec()).context("the report is not UTF-8")?,
-        })
+        };
+        let receivers = data.receiver_texels.len() + 6 * data.grid_points();
+        let counts = [
+            data.receiver_clusters.len(),
+            data.receiver_offsets.len(),
+            data.receiver_sky.len(),
+        ];
+        if counts.iter().any(|&n| n != receivers) {
+            bail!("the receivers' tables do not match their count ({receivers})");
+        }
+        Ok(data)
+    }
+
+    /// The points of the grid of spatial receivers.
+    pub fn grid_points(&self) -> usize {
+        self.grid_size.iter().map(|&n| n as usize).product()
+    }
+}
+
+/// The one element of a section that holds exactly one.
+fn exactly<T: Copy>(v: Vec<T>, what: &str) -> Result<T> {
+    match v.as_slice() {
+        [x] => Ok(*x),
+        _ => bail!("{what} is malformed"),
     }
 }

@@ -6,13 +6,16 @@
 //!   onto the harmonics (λ);
 //! - `probe_basis`: each cluster's basis vectors from its probes' λ;
 //! - `probe_receivers`: each receiver's irradiance into the lightmap;
+//! - `probe_grid`: where moving meshes are, the irradiance of the grid's spatial receivers
+//!   around them (4.1; the basis pass computes their clusters' vectors too);
 //! - `probe_gather`: the lightmap at the uv of each pixel's triangle (the G-buffer numbers
-//!   them), as the screen contract's indirect term.
+//!   them), or for a moving mesh the grid at its position, as the screen contract's
+//!   indirect term.
 //!
 //! Two lightmaps alternate: a frame writes one and its relight reads the other, last
-//! frame's. Visibility is the bake's: moving meshes neither block nor bounce light here,
-//! and have no lightmap (they get no indirect light until the grid of spatial receivers,
-//! 4.1, exists).
+//! frame's. Visibility is the bake's: moving meshes neither block nor bounce light here
+//! (the shadow maps still see them, so they do cast direct shadows); they have no
+//! lightmap and are shaded from the grid.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -23,6 +26,7 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use super::file::BakeData;
+use super::grid::Grid;
 use super::sh::Basis;
 use super::{octahedral, BakeReport, BakeSettings, Origin};
 use crate::gi::{
@@ -33,8 +37,9 @@ use crate::gpu_layout::{self as layout, ProbeUniforms, RayHit, RAY_NONE};
 use crate::ray::surfaces::{texel_buffer, SceneTriangles};
 use crate::scene::Scene;
 use crate::vk::{
-    clear_to_zero, compute_to_compute, groups_2d, sampler_info, Binding, Buffer, Context,
-    DescriptorSets, Image, ImageDesc, ImageUse, OneShot, Pipeline, Sampler, SetWriter, TexelBuffer,
+    clear_to_zero, compute_to_compute, groups_2d, sampler_info, stage_barrier, update_buffer,
+    Binding, Buffer, Context, DescriptorSets, Image, ImageDesc, ImageUse, OneShot, Pipeline,
+    Sampler, SetWriter, TexelBuffer,
 };
 
 /// The technique's settings: the bake's, and where its file is.
@@ -116,6 +121,16 @@ struct Tables {
     /// Per lightmap texel, its receiver's cluster (`RAY_NONE`: none).
     texel_clusters: Vec<u32>,
     uniforms: ProbeUniforms,
+    grid: Option<GridTables>,
+}
+
+/// What the host needs to list the grid's work of a frame.
+struct GridTables {
+    grid: Grid,
+    /// Per spatial receiver (in the bake's order), its cluster.
+    clusters: Vec<u32>,
+    /// Per cluster, its first basis vector and their count.
+    vectors: Vec<(u32, u32)>,
 }
 
 impl Tables {
@@ -186,12 +201,13 @@ impl Tables {
                 ]);
             }
         }
-        let receivers = (0..data.receiver_texels.len())
+        // The grid's receivers have no texel: `probe_grid` places them by their index.
+        let receivers = (0..data.receiver_clusters.len())
             .map(|r| {
-                let [x, y] = data.receiver_texels[r];
+                let texel = data.receiver_texels.get(r).map_or(0, |&[x, y]| x | y << 16);
                 let c = data.receiver_clusters[r] as usize;
                 [
-                    x | y << 16,
+                    texel,
                     data.receiver_offsets[r],
                     first_vector[c],
                     data.cluster_basis[c],
@@ -205,15 +221,59 @@ impl Tables {
         }
         let mut coordinates = data.coordinates.clone();
         coordinates.extend_from_slice(&data.receiver_sky);
+        // The grid's clusters follow the lightmap's (`super::compute`).
+        let lightmap_receivers = data.receiver_texels.len();
+        let lightmap_clusters = data.receiver_clusters[..lightmap_receivers]
+            .iter()
+            .map(|&c| c + 1)
+            .max()
+            .unwrap_or(0);
+        let spatial = &data.receiver_clusters[lightmap_receivers..];
+        if spatial.iter().any(|&c| c < lightmap_clusters) {
+            bail!("the bake's grid shares clusters with its lightmap");
+        }
+        let lightmap_vectors = first_vector
+            .get(lightmap_clusters as usize)
+            .copied()
+            .unwrap_or(vectors.len() as u32);
+        let grid = (data.grid_points() > 0).then(|| {
+            let [min, max] = data.grid_bounds.map(glam::Vec3::from);
+            GridTables {
+                grid: Grid {
+                    size: glam::UVec3::from_array(data.grid_size),
+                    min,
+                    max,
+                },
+                clusters: spatial.to_vec(),
+                vectors: (0..clusters)
+                    .map(|c| (first_vector[c], data.cluster_basis[c]))
+                    .collect(),
+            }
+        });
+        let (grid_min, grid_inverse_extent) = match &grid {
+            Some(g) => {
+                let extent = g.grid.max - g.grid.min;
+                let inverse = extent.map(|e| if e > 0.0 { 1.0 / e } else { 0.0 });
+                (
+                    g.grid.min.extend(0.0).to_array(),
+                    inverse.extend(0.0).to_array(),
+                )
+            }
+            None => ([0.0; 4], [0.0; 4]),
+        };
+        let [gx, gy, gz] = data.grid_size;
         let uniforms = ProbeUniforms {
             probe_count: data.probes.len() as u32,
             rays_per_probe: rays as u32,
             coefficients: n as u32,
-            receiver_count: data.receiver_texels.len() as u32,
-            vector_count: vectors.len() as u32,
+            receiver_count: lightmap_receivers as u32,
+            vector_count: lightmap_vectors,
             sky_offset: data.coordinates.len() as u32,
             bounces: u32::from(bounces),
             debug_radius,
+            grid_size: [gx, gy, gz, data.grid_points() as u32],
+            grid_min,
+            grid_inverse_extent,
         };
         Ok(Self {
             hits,
@@ -229,7 +289,51 @@ impl Tables {
             corner_uvs,
             texel_clusters,
             uniforms,
+            grid,
         })
+    }
+}
+
+impl GridTables {
+    /// The grid's work at scene time `time_s`: the points a lookup on any moving mesh's
+    /// box reads, their six receivers and their clusters' basis vectors, as the list of
+    /// `BINDING_PROBE_GRID_ACTIVE` (`receivers` indexes the receivers' table, after the
+    /// lightmap's `lightmap_receivers`).
+    fn active(&self, scene: &Scene, time_s: f32, lightmap_receivers: u32) -> Vec<u32> {
+        let points = self.grid.point_count();
+        let mut point_on = vec![false; points];
+        for m in (0..scene.meshes.len()).filter(|&m| scene.meshes[m].animation.is_some()) {
+            let bounds = scene.meshes[m]
+                .local_bounds
+                .transformed(scene.mesh_transform(m, time_s));
+            if let Some(footprint) = self.grid.footprint(&bounds) {
+                for p in self.grid.points_in(footprint) {
+                    point_on[p] = true;
+                }
+            }
+        }
+        let mut cluster_on = vec![false; self.vectors.len()];
+        let mut receivers = Vec::new();
+        for d in 0..super::grid::DIRECTIONS.len() {
+            for p in (0..points).filter(|&p| point_on[p]) {
+                let s = d * points + p;
+                cluster_on[self.clusters[s] as usize] = true;
+                receivers.push(lightmap_receivers + s as u32);
+            }
+        }
+        let vectors: Vec<u32> = cluster_on
+            .iter()
+            .enumerate()
+            .filter(|(_, &on)| on)
+            .flat_map(|(c, _)| {
+                let (first, count) = self.vectors[c];
+                first..first + count
+            })
+            .collect();
+        let mut list = vec![vectors.len() as u32, receivers.len() as u32];
+        list.extend(vectors);
+        list.extend(receivers);
+        list
     }
 }
 
@@ -345,6 +449,12 @@ pub struct ProbeGi {
     basis: Buffer,
     /// Written by alternate frames.
     lightmaps: [Image; 2],
+    /// The grid of spatial receivers' irradiance, and this frame's list of its work.
+    grid: Image,
+    grid_active: Buffer,
+    grid_tables: Option<GridTables>,
+    /// The spatial receivers the last recorded frame computed.
+    active_spatial_receivers: u32,
     /// Referenced by the sets.
     _sampler: Sampler,
     _sets: DescriptorSets,
@@ -353,6 +463,7 @@ pub struct ProbeGi {
     relight: Pipeline,
     basis_pass: Pipeline,
     receivers: Pipeline,
+    grid_pass: Pipeline,
     gather: Pipeline,
     counts: ProbeUniforms,
     /// The lightmap the next frame writes.
@@ -459,7 +570,7 @@ impl ProbeGi {
         let basis = Buffer::new(
             ctx,
             "probe cluster basis",
-            (vec4 * u64::from(counts.vector_count)).max(vec4),
+            (vec4 * tables.vectors.len() as u64).max(vec4),
             storage,
             MemoryLocation::GpuOnly,
         )?;
@@ -485,10 +596,60 @@ impl ProbeGi {
             )
         };
         let lightmaps = [lightmap(0)?, lightmap(1)?];
-        OneShot::new(ctx)?.run("clearing the probe lightmaps", |cmd| {
-            for image in &lightmaps {
+        let [gx, gy, gz, points] = counts.grid_size;
+        let limit = ctx.properties.limits.max_image_dimension3_d;
+        if gx.max(gy).max(6 * gz) > limit {
+            bail!(
+                "the bake's grid of spatial receivers is {gx} × {gy} × {gz} points, whose six \
+                 slabs need an image {gx} × {gy} × {}, more than the {limit} this device ({}) \
+                 allows: bake fewer --spatial-receivers",
+                6 * gz,
+                ctx.device_name()
+            );
+        }
+        let grid = Image::new(
+            ctx,
+            "probe grid",
+            ImageDesc {
+                extent: vk::Extent3D {
+                    width: gx.max(1),
+                    height: gy.max(1),
+                    depth: (6 * gz).max(1),
+                },
+                ..ImageDesc::d3(
+                    LIGHTMAP_FORMAT,
+                    1,
+                    1,
+                    vk::ImageUsageFlags::STORAGE
+                        | vk::ImageUsageFlags::SAMPLED
+                        | vk::ImageUsageFlags::TRANSFER_DST
+                        | vk::ImageUsageFlags::TRANSFER_SRC,
+                )
+            },
+        )?;
+        // The counts, then at most every grid cluster's vectors and every spatial receiver.
+        let spatial_vectors = tables.vectors.len() as u64 - u64::from(counts.vector_count);
+        let grid_active = Buffer::new(
+            ctx,
+            "probe grid active",
+            4 * (2 + spatial_vectors + 6 * u64::from(points)),
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?;
+        OneShot::new(ctx)?.run("clearing the probe lightmaps and grid", |cmd| {
+            for image in lightmaps.iter().chain([&grid]) {
                 clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, LIGHTMAP_USE);
             }
+            unsafe {
+                ctx.device
+                    .cmd_fill_buffer(cmd, grid_active.raw, 0, vk::WHOLE_SIZE, 0)
+            };
+            stage_barrier(
+                ctx,
+                cmd,
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+            );
             Ok(())
         })?;
         let sampler = Sampler::new(
@@ -539,6 +700,17 @@ impl ProbeGi {
             ),
             Binding::new(layout::BINDING_PROBE_SURFACES_READ, texels, compute),
             Binding::new(layout::BINDING_PROBE_TEXEL_CLUSTERS, texels, compute),
+            Binding::new(
+                layout::BINDING_PROBE_GRID,
+                vk::DescriptorType::STORAGE_IMAGE,
+                compute,
+            ),
+            Binding::new(layout::BINDING_PROBE_GRID_SAMPLED, sampled, compute),
+            Binding::new(
+                layout::BINDING_PROBE_GRID_ACTIVE,
+                vk::DescriptorType::STORAGE_BUFFER,
+                compute,
+            ),
         ]);
         let descriptor_sets = DescriptorSets::new(ctx, "probes", &bindings, 2)?;
         let sets = [
@@ -557,6 +729,18 @@ impl ProbeGi {
                 )
                 .buffer(layout::BINDING_PROBE_LAMBDA, storage_buffer, lambda.raw)
                 .buffer(layout::BINDING_PROBE_BASIS, storage_buffer, basis.raw)
+                .buffer(
+                    layout::BINDING_PROBE_GRID_ACTIVE,
+                    storage_buffer,
+                    grid_active.raw,
+                )
+                .storage_image(layout::BINDING_PROBE_GRID, grid.view)
+                .sampled_image(
+                    layout::BINDING_PROBE_GRID_SAMPLED,
+                    grid.view,
+                    sampler.raw,
+                    vk::ImageLayout::GENERAL,
+                )
                 .texel_buffer(layout::BINDING_PROBE_HITS, hits.view())
                 .buffer(
                     layout::BINDING_PROBE_SURFACES,
@@ -604,6 +788,7 @@ impl ProbeGi {
         let relight = pipeline("probe_relight", s::GI_PROBES_RELIGHT_COMP, &coefficients)?;
         let basis_pass = pipeline("probe_basis", s::GI_PROBES_BASIS_COMP, &coefficients)?;
         let receivers = pipeline("probe_receivers", s::GI_PROBES_RECEIVERS_COMP, &[])?;
+        let grid_pass = pipeline("probe_grid", s::GI_PROBES_GRID_COMP, &[])?;
         let gather = pipeline("probe_gather", s::GI_PROBES_GATHER_COMP, &[])?;
         let decode = pipeline("probe_surfaces", s::GI_PROBES_SURFACES_COMP, &[])?;
         OneShot::new(ctx)?.run("probe_surfaces", |cmd| {
@@ -640,12 +825,17 @@ impl ProbeGi {
             lambda,
             basis,
             lightmaps,
+            grid,
+            grid_active,
+            grid_tables: tables.grid,
+            active_spatial_receivers: 0,
             _sampler: sampler,
             _sets: descriptor_sets,
             sets,
             relight,
             basis_pass,
             receivers,
+            grid_pass,
             gather,
             counts,
             next: 0,
@@ -669,6 +859,11 @@ impl ProbeGi {
     /// Its size in texels.
     pub fn lightmap_size(&self) -> [u32; 2] {
         self.lightmap_size
+    }
+
+    /// The grid of spatial receivers' irradiance / π (`BINDING_PROBE_GRID`).
+    pub fn grid(&self) -> &Image {
+        &self.grid
     }
 }
 
@@ -696,12 +891,46 @@ impl Technique for ProbeGi {
         // Last frame's passes read and wrote what this one rewrites.
         compute_to_compute(ctx, cmd);
         if self.clear {
-            for image in &self.lightmaps {
+            for image in self.lightmaps.iter().chain([&self.grid]) {
                 clear_to_zero(ctx, cmd, image, LIGHTMAP_USE, LIGHTMAP_USE);
             }
             self.clear = false;
         }
         let c = &self.counts;
+        // The grid's work where moving meshes are this frame; none without them.
+        let (mut listed_vectors, mut listed_receivers) = (0, 0);
+        let scene = frame.draw.scene;
+        if let Some(grid) = self
+            .grid_tables
+            .as_ref()
+            .filter(|_| scene.has_moving_meshes())
+        {
+            let list = grid.active(scene, frame.draw.time_s, c.receiver_count);
+            (listed_vectors, listed_receivers) = (list[0], list[1]);
+            // Earlier frames' passes read the list this rewrites.
+            stage_barrier(
+                ctx,
+                cmd,
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::PipelineStageFlags2::ALL_TRANSFER,
+            );
+            // vkCmdUpdateBuffer takes 64 KiB at most.
+            const CHUNK: usize = 65536;
+            for (i, chunk) in bytemuck::cast_slice::<u32, u8>(&list)
+                .chunks(CHUNK)
+                .enumerate()
+            {
+                update_buffer(
+                    ctx,
+                    cmd,
+                    self.grid_active.raw,
+                    (i * CHUNK) as u64,
+                    chunk,
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                );
+            }
+        }
+        self.active_spatial_receivers = listed_receivers;
         for _ in 0..self.iterations {
             let sets = [
                 (layout::SET_FRAME, frame.draw.frame_set),
@@ -712,7 +941,7 @@ impl Technique for ProbeGi {
             timer.end(cmd);
             compute_to_compute(ctx, cmd);
             timer.begin(cmd, "probe_basis");
-            let groups = c.vector_count.div_ceil(layout::PROBE_GROUP_SIZE);
+            let groups = (c.vector_count + listed_vectors).div_ceil(layout::PROBE_GROUP_SIZE);
             self.basis_pass.dispatch(cmd, &sets, [groups, 1, 1]);
             timer.end(cmd);
             compute_to_compute(ctx, cmd);
@@ -724,6 +953,19 @@ impl Technique for ProbeGi {
             self.next = 1 - self.next;
         }
         self.iterations = 1;
+        if listed_receivers > 0 {
+            // After the last bounce's basis vectors; nothing in the transport reads the
+            // grid (moving meshes do not bounce light here).
+            timer.begin(cmd, "probe_grid");
+            let sets = [
+                (layout::SET_FRAME, frame.draw.frame_set),
+                (layout::SET_GI, self.sets[self.next]),
+            ];
+            let groups = listed_receivers.div_ceil(layout::PROBE_GROUP_SIZE);
+            self.grid_pass.dispatch(cmd, &sets, [groups, 1, 1]);
+            timer.end(cmd);
+            compute_to_compute(ctx, cmd);
+        }
         Ok(())
     }
 
@@ -778,6 +1020,10 @@ impl Technique for ProbeGi {
             "probe_lightmaps",
             self.lightmaps.iter().map(Image::memory_bytes).sum(),
         ));
+        bytes.push((
+            "probe_grid",
+            self.grid.memory_bytes() + self.grid_active.size,
+        ));
         bytes
     }
 
@@ -798,6 +1044,14 @@ impl Technique for ProbeGi {
                 f64::from(r.lightmap[0] * r.lightmap[1]),
             ),
             ("unseen_hit_share".into(), r.unseen_hit_share),
+            (
+                "spatial_receivers".into(),
+                6.0 * f64::from(self.counts.grid_size[3]),
+            ),
+            (
+                "active_spatial_receivers".into(),
+                f64::from(self.active_spatial_receivers),
+            ),
         ])
     }
 
