@@ -395,17 +395,7 @@ impl CommonArgs {
                         name.unwrap_or_default()
                     );
                 }
-                let settings = crate::gi::probes::frame::ProbeSettings {
-                    bake: self.probes.settings(scene)?,
-                    bake_file: self.probes.bake_file.clone(),
-                    bounces: self
-                        .probes
-                        .probe_bounces
-                        .or(scene.probe_bounces)
-                        .unwrap_or(crate::gi::probes::frame::ProbeSettings::default().bounces),
-                };
-                settings.check()?;
-                GiSettings::Probes(settings)
+                GiSettings::Probes(self.probes.frame_settings(scene)?)
             }
             GiMode::Off => {
                 if self.debug_view != DebugView::None {

@@ -345,7 +345,7 @@ gpu_layout! {
         BINDING_PROBE_LAMBDA = 11;
         /// Irradiance probes (set 3): per basis vector of every cluster, a `usamplerBuffer` texel:
         /// the cluster's first probe in `BINDING_PROBE_CLUSTER_PROBES`, its probe count, the
-        /// vector's row in `BINDING_PROBE_PROJECTIONS`, and 0.
+        /// vector's row in `BINDING_PROBE_PROJECTIONS`, and the cluster.
         BINDING_PROBE_VECTORS = 12;
         /// Irradiance probes (set 3): each cluster's probes, a `usamplerBuffer` of one index each.
         BINDING_PROBE_CLUSTER_PROBES = 13;
@@ -393,6 +393,12 @@ gpu_layout! {
         /// buffer: the count of the spatial clusters' basis vectors listed, the count of the
         /// spatial receivers listed, then the vectors' indices and the receivers'.
         BINDING_PROBE_GRID_ACTIVE = 28;
+        /// Irradiance probes (set 3): this frame's level of detail (Sedláček 2019, 4.2), `uint[]`
+        /// storage buffer: per probe, the harmonic coefficients its relight projects onto
+        /// (low 16 bits) and the stride of its rays along each axis of its map (high 16 bits);
+        /// then (from `probe_count` on) per cluster, the coefficients of each probe its basis
+        /// vectors read.
+        BINDING_PROBE_LOD = 29;
         /// Workgroup size of the probe passes.
         PROBE_GROUP_SIZE = 64;
 

@@ -229,6 +229,10 @@ fn bad_bake_settings_and_scenes() {
         &["bake", "--probe-bounces", "2"],
         &["--probe-bounces", "not its bake"],
     );
+    assert_fails_naming(
+        &["bake", "--probe-lod", "off"],
+        &["--probe-lod", "not its bake"],
+    );
 }
 
 #[test]
@@ -264,6 +268,18 @@ fn bad_probe_settings() {
             "x.png",
         ],
         &["--spatial-receivers 300000", "0 to 262144"],
+    );
+    assert_fails_naming(
+        &[
+            "render",
+            "--gi",
+            "probes",
+            "--lod-distances",
+            "4,2,8",
+            "-o",
+            "x.png",
+        ],
+        &["--lod-distances 4,2,8", "increasing"],
     );
     assert_fails_naming(
         &[

@@ -10,8 +10,13 @@ use crate::scene::Scene;
 use crate::vk::{Context, ContextOptions};
 
 pub fn run(args: &BakeArgs) -> Result<BakeReport> {
-    if args.probes.probe_bounces.is_some() {
-        anyhow::bail!("--probe-bounces sets the frame of --gi probes, not its bake");
+    let frame_options = [
+        (args.probes.probe_bounces.is_some(), "--probe-bounces"),
+        (args.probes.probe_lod.is_some(), "--probe-lod"),
+        (args.probes.lod_distances.is_some(), "--lod-distances"),
+    ];
+    if let Some((_, flag)) = frame_options.iter().find(|(given, _)| *given) {
+        anyhow::bail!("{flag} sets the frame of --gi probes, not its bake");
     }
     let path = args.scene.clone().unwrap_or_else(default_scene);
     let scene = Scene::load(&path, &Default::default())

@@ -71,6 +71,8 @@
 //! max_basis = 32                 # --max-basis
 //! spatial_receivers = 2048       # --spatial-receivers
 //! probe_bounces = 8              # --probe-bounces (--gi probes)
+//! probe_lod = true               # --probe-lod on|off (--gi probes)
+//! lod_distances = [4.0, 8.0, 16.0]   # --lod-distances (--gi probes)
 //! ```
 //!
 //! `spin` turns about the centre of the entry's object-space bounds at `deg_per_s`;

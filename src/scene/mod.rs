@@ -225,6 +225,10 @@ pub struct GiOverrides {
     pub spatial_receivers: Option<u32>,
     /// The irradiance probes' bounces in a first frame.
     pub probe_bounces: Option<u32>,
+    /// The irradiance probes' level of detail, and the distances where its levels 1 to 3
+    /// begin.
+    pub probe_lod: Option<bool>,
+    pub lod_distances: Option<[f32; 3]>,
 }
 
 #[derive(Clone, Debug)]

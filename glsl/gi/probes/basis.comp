@@ -20,6 +20,9 @@ layout(set = SET_GI, binding = BINDING_PROBE_BASIS, std430) writeonly buffer Bas
 layout(set = SET_GI, binding = BINDING_PROBE_GRID_ACTIVE, std430) readonly buffer ActiveBlock {
     uint grid_active[];
 };
+layout(set = SET_GI, binding = BINDING_PROBE_LOD, std430) readonly buffer LodBlock {
+    uint lod[];
+};
 
 void main() {
     uint v = gl_GlobalInvocationID.x;
@@ -31,14 +34,17 @@ void main() {
         v = grid_active[GRID_ACTIVE_LIST + listed];
     }
     uvec4 vector = texelFetch(vectors, int(v));
+    // The level of detail (4.2.2): the cluster's first coefficients of each probe, no
+    // more than the probe's relight projected this frame (the rest of its λ is stale).
+    uint wanted = lod[probes.probe_count + vector.w];
     vec3 b = vec3(0.0);
-    int at = int(vector.z);
     for (uint k = 0u; k < vector.y; k++) {
         uint probe = texelFetch(cluster_probes, int(vector.x + k)).r;
+        uint count = min(wanted, lod[probe] & 0xFFFFu);
         uint first = probe * COEFFICIENTS;
-        for (uint j = 0u; j < COEFFICIENTS; j++) {
-            b += texelFetch(projections, at).r * lambda[first + j].rgb;
-            at++;
+        int at = int(vector.z + k * COEFFICIENTS);
+        for (uint j = 0u; j < count; j++) {
+            b += texelFetch(projections, at + int(j)).r * lambda[first + j].rgb;
         }
     }
     basis[v] = vec4(b, 0.0);

@@ -24,6 +24,9 @@ layout(set = SET_GI, binding = BINDING_PROBE_LAMBDA, std430) writeonly buffer La
     vec4 lambda[];
 };
 layout(set = SET_GI, binding = BINDING_PROBE_LIGHTMAP_PREVIOUS) uniform sampler2D previous_lightmap;
+layout(set = SET_GI, binding = BINDING_PROBE_LOD, std430) readonly buffer LodBlock {
+    uint lod[];
+};
 
 // The sums are reduced a block of coefficients at a time: the whole of band 7 (64
 // coefficients × 64 invocations × RGB) would not fit the 16 KiB of shared memory every
@@ -64,29 +67,40 @@ vec3 radiance_along(uint ray) {
 void main() {
     uint probe = gl_WorkGroupID.x;
     uint lane = gl_LocalInvocationID.x;
+    // The level of detail (4.2.1): the first `count` coefficients (the low bands are the
+    // same functions whatever the order), from the texels at the centres of stride ×
+    // stride blocks of the map, each standing for its block's solid angle.
+    uint count = min(lod[probe] & 0xFFFFu, COEFFICIENTS);
+    uint stride = lod[probe] >> 16u;
+    // The map is square: its side is exact in floats up to the largest maps.
+    uint side = uint(round(sqrt(float(probes.rays_per_probe))));
+    uint sub = side / stride;
+    float weight = float(probes.rays_per_probe) / float(sub * sub);
     vec3 sums[COEFFICIENTS];
     for (uint j = 0u; j < COEFFICIENTS; j++) {
         sums[j] = vec3(0.0);
     }
     uint first = probe * probes.rays_per_probe;
-    for (uint ray = lane; ray < probes.rays_per_probe; ray += PROBE_GROUP_SIZE) {
+    for (uint i = lane; i < sub * sub; i += PROBE_GROUP_SIZE) {
+        uint ray = ((i / sub) * stride + stride / 2u) * side + (i % sub) * stride + stride / 2u;
         vec3 l = radiance_along(first + ray);
         if (all(equal(l, vec3(0.0)))) {
             continue;
         }
+        l *= weight;
         int at = int(ray * COEFFICIENTS);
-        for (uint j = 0u; j < COEFFICIENTS; j++) {
+        for (uint j = 0u; j < count; j++) {
             sums[j] += l * texelFetch(ray_harmonics, at + int(j)).r;
         }
     }
-    for (uint block = 0u; block < COEFFICIENTS; block += BLOCK) {
+    for (uint block = 0u; block < count; block += BLOCK) {
         for (uint k = 0u; k < BLOCK; k++) {
             uint j = block + k;
-            partial[k * PROBE_GROUP_SIZE + lane] = j < COEFFICIENTS ? sums[j] : vec3(0.0);
+            partial[k * PROBE_GROUP_SIZE + lane] = j < count ? sums[j] : vec3(0.0);
         }
         barrier();
         uint j = block + lane;
-        if (lane < BLOCK && j < COEFFICIENTS) {
+        if (lane < BLOCK && j < count) {
             vec3 total = vec3(0.0);
             for (uint i = 0u; i < PROBE_GROUP_SIZE; i++) {
                 total += partial[lane * PROBE_GROUP_SIZE + i];

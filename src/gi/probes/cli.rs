@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Result};
 use clap::Args;
 
+use super::frame::ProbeSettings;
 use super::BakeSettings;
 use crate::scene::GiOverrides;
 
@@ -61,9 +62,56 @@ pub struct ProbeArgs {
     /// [default: 8].
     #[arg(long)]
     pub probe_bounces: Option<u32>,
+    /// `--gi probes`: the dynamic level of detail by camera distance (Sedláček 2019, 4.2):
+    /// fewer harmonic bands and relight rays for far probes and clusters; `off` computes
+    /// every probe and cluster in full, the reference [default: on].
+    #[arg(long, value_enum)]
+    pub probe_lod: Option<Switch>,
+    /// `--gi probes`: the camera distances where levels 1, 2 and 3 of the level of detail
+    /// begin, in scene units, increasing [default: 16, 32 and 64 probe radii].
+    #[arg(long, value_delimiter = ',')]
+    pub lod_distances: Option<Vec<f32>>,
+}
+
+/// On or off.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Switch {
+    On,
+    Off,
 }
 
 impl ProbeArgs {
+    /// The frame's settings: the command line over the scene file's `[gi]` over the
+    /// defaults (checked by [`ProbeSettings::check`]).
+    pub fn frame_settings(&self, scene: &GiOverrides) -> Result<ProbeSettings> {
+        let d = ProbeSettings::default();
+        let distances = match self.lod_distances.as_deref() {
+            Some(v) => Some(<[f32; 3]>::try_from(v).map_err(|_| {
+                anyhow::anyhow!(
+                    "--lod-distances: give three distances, D1,D2,D3 (got {})",
+                    v.len()
+                )
+            })?),
+            None => scene.lod_distances,
+        };
+        let settings = ProbeSettings {
+            bake: self.settings(scene)?,
+            bake_file: self.bake_file.clone(),
+            bounces: self
+                .probe_bounces
+                .or(scene.probe_bounces)
+                .unwrap_or(d.bounces),
+            lod: self
+                .probe_lod
+                .map(|s| s == Switch::On)
+                .or(scene.probe_lod)
+                .unwrap_or(d.lod),
+            lod_distances: distances,
+        };
+        settings.check()?;
+        Ok(settings)
+    }
+
     /// The options given, as their flags.
     pub fn given(&self) -> Vec<&'static str> {
         [
@@ -78,6 +126,8 @@ impl ProbeArgs {
             (self.spatial_receivers.is_some(), "--spatial-receivers"),
             (self.bake_file.is_some(), "--bake-file"),
             (self.probe_bounces.is_some(), "--probe-bounces"),
+            (self.probe_lod.is_some(), "--probe-lod"),
+            (self.lod_distances.is_some(), "--lod-distances"),
         ]
         .into_iter()
         .filter_map(|(set, flag)| set.then_some(flag))

@@ -56,6 +56,8 @@ pub struct Cluster {
     pub projection: Vec<f32>,
     /// The projection error (the thesis's measure).
     pub error: f64,
+    /// The box of its receivers' positions (the level of detail's distance, 4.2.2).
+    pub bounds: Aabb,
 }
 
 /// The clusters of every receiver.
@@ -104,8 +106,11 @@ impl Clusters {
                 None
             };
             match leaf {
-                Some(leaf) => {
+                Some(mut leaf) => {
                     let c = out.list.len() as u32;
+                    for &r in &members {
+                        leaf.cluster.bounds.extend(receivers[r as usize].position);
+                    }
                     for (row, &r) in members.iter().enumerate() {
                         out.cluster_of[r as usize] = c;
                         out.offsets[r as usize] = out.coordinates.len() as u32;
@@ -274,6 +279,7 @@ fn decompose(members: &[u32], transport: &Transport, settings: &ClusterSettings)
             basis: 0,
             projection: Vec::new(),
             error,
+            bounds: Aabb::EMPTY,
         },
         u: Vec::new(),
         residual: 0.0,
@@ -319,6 +325,7 @@ fn decompose(members: &[u32], transport: &Transport, settings: &ClusterSettings)
             basis: k,
             projection,
             error: error(k),
+            bounds: Aabb::EMPTY,
         },
         u: rows,
         residual: tail,

@@ -53,6 +53,8 @@ pub struct BakeData {
     pub cluster_basis: Vec<u32>,
     pub cluster_projection_starts: Vec<u32>,
     pub projections: Vec<f32>,
+    /// Per cluster, the box of its receivers (least and greatest corner).
+    pub cluster_bounds: Vec<[[f32; 3]; 2]>,
     /// The bake's report, as JSON.
     pub report: String,
 }
@@ -150,6 +152,7 @@ impl BakeData {
         section(&mut payload, &self.cluster_basis);
         section(&mut payload, &self.cluster_projection_starts);
         section(&mut payload, &self.projections);
+        section(&mut payload, &self.cluster_bounds);
         section(&mut payload, self.report.as_bytes());
         let mut file = Vec::with_capacity(HEADER + payload.len());
         file.extend_from_slice(MAGIC);
@@ -260,6 +263,7 @@ impl BakeData {
             cluster_basis: array(next()?)?,
             cluster_projection_starts: array(next()?)?,
             projections: array(next()?)?,
+            cluster_bounds: array(next()?)?,
             report: String::from_utf8(next()?.to_vec()).context("the report is not UTF-8")?,
         };
         let receivers = data.receiver_texels.len() + 6 * data.grid_points();
@@ -270,6 +274,13 @@ impl BakeData {
         ];
         if counts.iter().any(|&n| n != receivers) {
             bail!("the receivers' tables do not match their count ({receivers})");
+        }
+        let clusters = data.cluster_basis.len();
+        if data.cluster_bounds.len() != clusters
+            || data.cluster_probe_starts.len() != clusters + 1
+            || data.cluster_projection_starts.len() != clusters + 1
+        {
+            bail!("the clusters' tables do not match their count ({clusters})");
         }
         Ok(data)
     }

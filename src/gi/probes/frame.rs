@@ -53,6 +53,10 @@ pub struct ProbeSettings {
     /// than one, every later frame adds one more on top of the last frame's lightmap, so
     /// the bounces converge as a geometric series.
     pub bounces: u32,
+    /// The dynamic level of detail (4.2), and the camera distances where its levels 1 to 3
+    /// begin (`None`: [`LOD_RADII`] probe radii).
+    pub lod: bool,
+    pub lod_distances: Option<[f32; 3]>,
 }
 
 impl Default for ProbeSettings {
@@ -61,6 +65,8 @@ impl Default for ProbeSettings {
             bake: BakeSettings::default(),
             bake_file: None,
             bounces: 8,
+            lod: true,
+            lod_distances: None,
         }
     }
 }
@@ -74,6 +80,18 @@ impl ProbeSettings {
                 "--probe-bounces {}: give 1 to {MAX_BOUNCES} bounces",
                 self.bounces
             );
+        }
+        if let Some(d) = self.lod_distances {
+            let increasing = d[0] > 0.0 && d[0] < d[1] && d[1] < d[2] && d[2].is_finite();
+            if !increasing {
+                bail!(
+                    "--lod-distances {},{},{}: give three finite distances, above zero and \
+                     increasing",
+                    d[0],
+                    d[1],
+                    d[2]
+                );
+            }
         }
         Ok(())
     }
@@ -107,6 +125,79 @@ pub const MAX_BOUNCES: u32 = 64;
 
 /// The most workgroups of one dispatch along x that every device runs.
 const MAX_GROUPS: u32 = 65535;
+
+/// The level of detail's levels (Sedláček 2019, 4.2): per level, the highest harmonic
+/// band the probes project onto (never above the bake's) and the stride of the relight's
+/// rays along each axis of the probes' maps. The thesis's example: 64, 25 and 16
+/// coefficients, and rays halved level by level; here a level quarters the rays, as
+/// the map's blocks do, until 256 of 4,096 are left.
+const LOD_BANDS: [u32; 4] = [7, 5, 3, 2];
+const LOD_RAY_STRIDE: [u32; 4] = [1, 2, 4, 4];
+
+/// Where levels 1, 2 and 3 begin by default, in probe radii from the camera. Band 7
+/// resolves about a seventh of a probe's sphere, detail a half radius across on its
+/// receivers: 16 radii away that still spans 1.8° (12 pixels of a 256² view at 39°). With
+/// levels from 8 radii, half the Cornell box's receivers drop to bands 0 to 5 and its
+/// LDR-FLIP goes from 0.070 to 0.079; from 16 the box is all level 0.
+pub const LOD_RADII: [f32; 3] = [16.0, 32.0, 64.0];
+
+/// The level of detail of each frame, from the camera's position.
+struct LevelsOfDetail {
+    /// Where levels 1 to 3 begin.
+    distances: [f32; 3],
+    order: u32,
+    probes: usize,
+    /// Per cluster, its receivers' box and its probes.
+    bounds: Vec<crate::scene::Aabb>,
+    cluster_probes: Vec<std::ops::Range<usize>>,
+    probe_list: Vec<u32>,
+}
+
+impl LevelsOfDetail {
+    /// A probe's entry and a cluster's in `BINDING_PROBE_LOD` at `level`.
+    fn coefficients(&self, level: usize) -> u32 {
+        (LOD_BANDS[level].min(self.order) + 1).pow(2)
+    }
+
+    /// This frame's `BINDING_PROBE_LOD` for a camera at `camera` (`on`: else everything
+    /// at level 0), and the probes at each level. A cluster's level is that of its receivers' box's nearest point (4.2.2); a
+    /// probe takes the finest level of the clusters it supports, so that every basis
+    /// vector finds the coefficients it reads (the thesis shifts the probes' distance by
+    /// their radius to the same end, 4.2.1).
+    fn entries(&self, camera: glam::Vec3, on: bool) -> (Vec<u32>, [u32; 4]) {
+        let level_at = |d: f32| {
+            if on {
+                self.distances.iter().filter(|&&l| d >= l).count()
+            } else {
+                0
+            }
+        };
+        let mut probe_level = vec![LOD_BANDS.len() - 1; self.probes];
+        let mut clusters = Vec::with_capacity(self.bounds.len());
+        for (bounds, probes) in self.bounds.iter().zip(&self.cluster_probes) {
+            let nearest = camera.clamp(bounds.min, bounds.max);
+            let level = level_at(camera.distance(nearest));
+            for &p in &self.probe_list[probes.clone()] {
+                let p = p as usize;
+                probe_level[p] = probe_level[p].min(level);
+            }
+            clusters.push(self.coefficients(level));
+        }
+        if !on {
+            probe_level.fill(0);
+        }
+        let mut per_level = [0u32; 4];
+        let mut entries: Vec<u32> = probe_level
+            .iter()
+            .map(|&l| {
+                per_level[l] += 1;
+                self.coefficients(l) | LOD_RAY_STRIDE[l] << 16
+            })
+            .collect();
+        entries.extend(clusters);
+        (entries, per_level)
+    }
+}
 
 /// The bake's tables as the passes read them, built on the host.
 struct Tables {
@@ -197,7 +288,7 @@ impl Tables {
                     data.cluster_probe_starts[c],
                     probes,
                     data.cluster_projection_starts[c] + i * width,
-                    0,
+                    c as u32,
                 ]);
             }
         }
@@ -455,6 +546,12 @@ pub struct ProbeGi {
     grid_tables: Option<GridTables>,
     /// The spatial receivers the last recorded frame computed.
     active_spatial_receivers: u32,
+    /// The level of detail (the viewer's switch), its buffer, and the probes at each
+    /// level in the last frame.
+    lod_on: bool,
+    lod: LevelsOfDetail,
+    lod_buffer: Buffer,
+    probes_per_level: [u32; 4],
     /// Referenced by the sets.
     _sampler: Sampler,
     _sets: DescriptorSets,
@@ -636,6 +733,35 @@ impl ProbeGi {
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuOnly,
         )?;
+        let lod = LevelsOfDetail {
+            distances: settings
+                .lod_distances
+                .unwrap_or(LOD_RADII.map(|r| r * bake.report.probe_radius)),
+            order: data.sh_order,
+            probes: data.probes.len(),
+            bounds: data
+                .cluster_bounds
+                .iter()
+                .map(|&[min, max]| crate::scene::Aabb {
+                    min: glam::Vec3::from(min),
+                    max: glam::Vec3::from(max),
+                })
+                .collect(),
+            cluster_probes: data
+                .cluster_probe_starts
+                .windows(2)
+                .map(|w| w[0] as usize..w[1] as usize)
+                .collect(),
+            probe_list: data.cluster_probes.clone(),
+        };
+        // Every frame writes its own; level 0 until the first.
+        let (entries, probes_per_level) = lod.entries(glam::Vec3::ZERO, false);
+        let lod_buffer = Buffer::with_data(
+            ctx,
+            "probe lod",
+            bytemuck::cast_slice(&entries),
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+        )?;
         OneShot::new(ctx)?.run("clearing the probe lightmaps and grid", |cmd| {
             for image in lightmaps.iter().chain([&grid]) {
                 clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, LIGHTMAP_USE);
@@ -711,6 +837,11 @@ impl ProbeGi {
                 vk::DescriptorType::STORAGE_BUFFER,
                 compute,
             ),
+            Binding::new(
+                layout::BINDING_PROBE_LOD,
+                vk::DescriptorType::STORAGE_BUFFER,
+                compute,
+            ),
         ]);
         let descriptor_sets = DescriptorSets::new(ctx, "probes", &bindings, 2)?;
         let sets = [
@@ -734,6 +865,7 @@ impl ProbeGi {
                     storage_buffer,
                     grid_active.raw,
                 )
+                .buffer(layout::BINDING_PROBE_LOD, storage_buffer, lod_buffer.raw)
                 .storage_image(layout::BINDING_PROBE_GRID, grid.view)
                 .sampled_image(
                     layout::BINDING_PROBE_GRID_SAMPLED,
@@ -829,6 +961,10 @@ impl ProbeGi {
             grid_active,
             grid_tables: tables.grid,
             active_spatial_receivers: 0,
+            lod_on: settings.lod,
+            lod,
+            lod_buffer,
+            probes_per_level,
             _sampler: sampler,
             _sets: descriptor_sets,
             sets,
@@ -897,6 +1033,34 @@ impl Technique for ProbeGi {
             self.clear = false;
         }
         let c = &self.counts;
+        // Earlier frames' passes read the lists this rewrites.
+        stage_barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::PipelineStageFlags2::ALL_TRANSFER,
+        );
+        let upload = |buffer: vk::Buffer, list: &[u32]| {
+            // vkCmdUpdateBuffer takes 64 KiB at most.
+            const CHUNK: usize = 65536;
+            for (i, chunk) in bytemuck::cast_slice::<u32, u8>(list)
+                .chunks(CHUNK)
+                .enumerate()
+            {
+                update_buffer(
+                    ctx,
+                    cmd,
+                    buffer,
+                    (i * CHUNK) as u64,
+                    chunk,
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                );
+            }
+        };
+        let camera = glam::Vec4::from(frame.uniforms.camera_position).truncate();
+        let (entries, per_level) = self.lod.entries(camera, self.lod_on);
+        upload(self.lod_buffer.raw, &entries);
+        self.probes_per_level = per_level;
         // The grid's work where moving meshes are this frame; none without them.
         let (mut listed_vectors, mut listed_receivers) = (0, 0);
         let scene = frame.draw.scene;
@@ -907,28 +1071,7 @@ impl Technique for ProbeGi {
         {
             let list = grid.active(scene, frame.draw.time_s, c.receiver_count);
             (listed_vectors, listed_receivers) = (list[0], list[1]);
-            // Earlier frames' passes read the list this rewrites.
-            stage_barrier(
-                ctx,
-                cmd,
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-            );
-            // vkCmdUpdateBuffer takes 64 KiB at most.
-            const CHUNK: usize = 65536;
-            for (i, chunk) in bytemuck::cast_slice::<u32, u8>(&list)
-                .chunks(CHUNK)
-                .enumerate()
-            {
-                update_buffer(
-                    ctx,
-                    cmd,
-                    self.grid_active.raw,
-                    (i * CHUNK) as u64,
-                    chunk,
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                );
-            }
+            upload(self.grid_active.raw, &list);
         }
         self.active_spatial_receivers = listed_receivers;
         for _ in 0..self.iterations {
@@ -1024,6 +1167,7 @@ impl Technique for ProbeGi {
             "probe_grid",
             self.grid.memory_bytes() + self.grid_active.size,
         ));
+        bytes.push(("probe_lod", self.lod_buffer.size));
         bytes
     }
 
@@ -1052,6 +1196,10 @@ impl Technique for ProbeGi {
                 "active_spatial_receivers".into(),
                 f64::from(self.active_spatial_receivers),
             ),
+            ("lod_probes_0".into(), f64::from(self.probes_per_level[0])),
+            ("lod_probes_1".into(), f64::from(self.probes_per_level[1])),
+            ("lod_probes_2".into(), f64::from(self.probes_per_level[2])),
+            ("lod_probes_3".into(), f64::from(self.probes_per_level[3])),
         ])
     }
 
@@ -1079,6 +1227,10 @@ impl Technique for ProbeGi {
     }
 
     fn switches(&mut self) -> Vec<Switch<'_>> {
-        Vec::new()
+        vec![Switch {
+            name: "level of detail",
+            key: 'l',
+            on: &mut self.lod_on,
+        }]
     }
 }

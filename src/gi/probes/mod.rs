@@ -454,6 +454,11 @@ pub fn compute(
             .iter()
             .flat_map(|c| c.projection.iter().copied())
             .collect(),
+        cluster_bounds: clusters
+            .list
+            .iter()
+            .map(|c| [c.bounds.min.to_array(), c.bounds.max.to_array()])
+            .collect(),
         report: serde_json::to_string(&report)?,
     };
     Ok((data, report))
