@@ -22,7 +22,7 @@ use winit::window::Window;
 
 use crate::cli::{CommonArgs, GiMode};
 use crate::gi::path::cli::PathArgs;
-use crate::gi::probes::cli::ProbeArgs;
+use crate::gi::probes::cli::{ProbeArgs, Switch};
 use crate::gi::vct::cli::VctArgs;
 use crate::gi::vct::voxelize::Voxelizer;
 use crate::gi::{DebugView, GiSettings};
@@ -543,7 +543,37 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                 );
             }
         }
-        GiSettings::Off | GiSettings::Probes(_) => {}
+        GiSettings::Probes(probes) => {
+            // The frame's settings: a rebuild reads the same bake from its file. The
+            // bake's own are the command line's (a change would bake again, minutes).
+            let args = &mut view.args.probes;
+            let mut bounces = probes.bounces;
+            settle(ui.add(egui::Slider::new(&mut bounces, 1..=64).text("first frame's bounces")));
+            override_if(&mut args.probe_bounces, bounces, probes.bounces);
+            let mut lod = probes.lod;
+            settle(ui.checkbox(&mut lod, "level of detail"));
+            if lod != probes.lod {
+                args.probe_lod = Some(if lod { Switch::On } else { Switch::Off });
+            }
+            if let Some(distances) = probes.lod_distances {
+                let mut d = distances;
+                ui.horizontal(|ui| {
+                    for (i, v) in d.iter_mut().enumerate() {
+                        settle(
+                            ui.add(egui::DragValue::new(v).speed(0.1).range(0.01..=1e6))
+                                .on_hover_text(format!("where level {} begins", i + 1)),
+                        );
+                    }
+                    ui.label("level distances");
+                });
+                if d != distances {
+                    args.lod_distances = Some(d.to_vec());
+                }
+            } else {
+                ui.label("levels from 16, 32 and 64 probe radii (--lod-distances)");
+            }
+        }
+        GiSettings::Off => {}
     }
     rebuild
 }
