@@ -104,6 +104,8 @@ pub struct ModelGeometry {
     pub vertices: Vec<Vertex>,
     pub indices: Vec<u32>,
     pub bounds: Aabb,
+    /// The second UV set per vertex, where the model gave one for every position.
+    pub lightmap_uvs: Vec<[f32; 2]>,
 }
 
 /// One model's vertex attributes as a file gives them, each list indexed by `indices`.
@@ -115,6 +117,9 @@ pub struct ModelAttributes<'a> {
     /// `[u, v]` with (0, 0) the top-left of the image; used only when there is one for
     /// every position.
     pub uvs: &'a [[f32; 2]],
+    /// A second UV set (glTF's TEXCOORD_1), the irradiance probes' lightmap UVs; used only
+    /// when there is one for every position.
+    pub lightmap_uvs: &'a [[f32; 2]],
     pub indices: &'a [u32],
 }
 
@@ -163,7 +168,8 @@ pub fn model_geometry(model: &ModelAttributes) -> Result<Option<ModelGeometry>> 
         return Ok(None);
     }
 
-    let (vertices, indices): (Vec<Vertex>, Vec<u32>) = if has_normals {
+    let second = model.lightmap_uvs.len() == count;
+    let (vertices, indices, lightmap_uvs): (Vec<Vertex>, Vec<u32>, Vec<[f32; 2]>) = if has_normals {
         let vertices = (0..count as u32)
             .map(|i| Vertex {
                 position: position(i).to_array(),
@@ -171,7 +177,16 @@ pub fn model_geometry(model: &ModelAttributes) -> Result<Option<ModelGeometry>> 
                 uv: uv(i),
             })
             .collect();
-        (vertices, triangles.iter().flat_map(|(t, _)| *t).collect())
+        let lightmap_uvs = if second {
+            model.lightmap_uvs.to_vec()
+        } else {
+            Vec::new()
+        };
+        (
+            vertices,
+            triangles.iter().flat_map(|(t, _)| *t).collect(),
+            lightmap_uvs,
+        )
     } else {
         // Flat normals from the winding (counter-clockwise = front), as the references use
         // for OBJs without normals (and glTF prescribes); each corner gets its own vertex.
@@ -186,7 +201,15 @@ pub fn model_geometry(model: &ModelAttributes) -> Result<Option<ModelGeometry>> 
             })
             .collect();
         let indices = (0..vertices.len() as u32).collect();
-        (vertices, indices)
+        let lightmap_uvs = if second {
+            triangles
+                .iter()
+                .flat_map(|(t, _)| t.map(|i| model.lightmap_uvs[i as usize]))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        (vertices, indices, lightmap_uvs)
     };
     let bounds = indices.iter().fold(Aabb::EMPTY, |mut b, &i| {
         b.extend(Vec3::from(vertices[i as usize].position));
@@ -196,6 +219,7 @@ pub fn model_geometry(model: &ModelAttributes) -> Result<Option<ModelGeometry>> 
         vertices,
         indices,
         bounds,
+        lightmap_uvs,
     }))
 }
 

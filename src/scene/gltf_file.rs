@@ -343,6 +343,12 @@ impl GltfFile<'_> {
             .read_tex_coords(uv.set)
             .map(|t| t.into_f32().map(|c| uv.apply(c)).collect())
             .unwrap_or_default();
+        // glTF gives the second UV set no meaning of its own; engines (Unity, Godot,
+        // three.js) take it for the lightmap, as the probes' bake does.
+        let lightmap_uvs: Vec<[f32; 2]> = reader
+            .read_tex_coords(1)
+            .map(|t| t.into_f32().collect())
+            .unwrap_or_default();
         let count = positions.len() as u32;
         let vertices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
@@ -359,12 +365,14 @@ impl GltfFile<'_> {
             positions: &positions,
             normals: &normals,
             uvs: &uvs,
+            lightmap_uvs: &lightmap_uvs,
             indices: &indices,
         };
         let Some(ModelGeometry {
             vertices,
             indices,
             bounds,
+            lightmap_uvs,
         }) = model_geometry(&attributes)?
         else {
             return Ok(None);
@@ -378,6 +386,7 @@ impl GltfFile<'_> {
             animation: None,
             local_bounds: bounds,
             object_bounds: bounds,
+            lightmap_uvs,
         }))
     }
 

@@ -112,6 +112,9 @@ pub struct Mesh {
     /// Object-space bounds of everything its scene-file entry loaded. Animations pivot about
     /// its centre, so that the many meshes of one OBJ move as one rigid object.
     pub object_bounds: Aabb,
+    /// The lightmap UVs of its vertices where the file has a second UV set (glTF's
+    /// TEXCOORD_1), (0, 0) the top-left; else empty (the probes' bake makes an atlas).
+    pub lightmap_uvs: Vec<[f32; 2]>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -54,12 +54,14 @@ pub fn add(geometry: &mut Geometry, entry: &MeshEntry, options: &LoadOptions) ->
             positions: &positions,
             normals: &normals,
             uvs: &uvs,
+            lightmap_uvs: &[],
             indices: &mesh.indices,
         };
         let Some(ModelGeometry {
             vertices,
             indices,
             bounds,
+            ..
         }) = model_geometry(&attributes).with_context(|| format!("in OBJ {}", path.display()))?
         else {
             continue;
@@ -77,6 +79,7 @@ pub fn add(geometry: &mut Geometry, entry: &MeshEntry, options: &LoadOptions) ->
             animation: entry.animation,
             local_bounds: bounds,
             object_bounds: bounds,
+            lightmap_uvs: Vec::new(),
         });
     }
     let triangles: usize = meshes.iter().map(|m| m.indices.len() / 3).sum();

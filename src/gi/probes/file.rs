@@ -89,6 +89,7 @@ pub fn content_key(scene: &Scene, settings: &BakeSettings) -> u128 {
     for mesh in scene.meshes.iter().filter(|m| m.animation.is_none()) {
         h.update(bytemuck::cast_slice(&mesh.vertices));
         h.update(bytemuck::cast_slice(&mesh.indices));
+        h.update(bytemuck::cast_slice(&mesh.lightmap_uvs));
         h.update(bytemuck::cast_slice(&mesh.transform.to_cols_array()));
         // What the rays see of its material: cut-outs and straight transmission.
         let material = &scene.materials[mesh.material as usize];

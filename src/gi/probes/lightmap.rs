@@ -35,20 +35,71 @@ pub struct Lightmap {
     /// in [0, 1] with (0, 0) the corner of texel row 0, column 0; empty for moving meshes,
     /// which the probes do not hold (Sedláček 2019, 4.1: they are lit from the grid).
     pub corners: Vec<Vec<[f32; 2]>>,
+    /// The UVs are the scene's own second set, not an atlas made here.
+    pub authored: bool,
 }
 
 impl Lightmap {
-    /// The atlas at the highest density that fits one `size` × `size` page.
+    /// The scene's own lightmap UVs on a `size` × `size` page where every static mesh has
+    /// them, inside the page (3.2.1.1: "use the mesh's second UV set where the scene has
+    /// one"); else the atlas at the highest density that fits one page.
     pub fn generate(scene: &Scene, size: u32) -> Result<Self> {
-        let meshes: Vec<usize> = (0..scene.meshes.len())
-            .filter(|&m| scene.meshes[m].animation.is_none() && !scene.meshes[m].indices.is_empty())
-            .collect();
-        if meshes.is_empty() {
-            bail!(
-                "{} has no static triangles to place receivers on",
-                scene.source.display()
-            );
+        let meshes = static_meshes(scene)?;
+        match Self::authored(scene, &meshes, size) {
+            Some(lightmap) => Ok(lightmap),
+            None => Self::unwrap(scene, &meshes, size),
         }
+    }
+
+    /// The scene's second UV set as the lightmap, if every static mesh has one within
+    /// [0, 1]². The texel density is the mean over the surfaces (the square root of the
+    /// page's texels the triangles cover over their world area).
+    fn authored(scene: &Scene, meshes: &[usize], size: u32) -> Option<Self> {
+        let usable = meshes.iter().all(|&m| {
+            let mesh = &scene.meshes[m];
+            mesh.lightmap_uvs.len() == mesh.vertices.len()
+                && mesh
+                    .lightmap_uvs
+                    .iter()
+                    .all(|uv| uv.iter().all(|c| (0.0..=1.0).contains(c)))
+        });
+        if !usable {
+            return None;
+        }
+        let mut corners = vec![Vec::new(); scene.meshes.len()];
+        let (mut uv_area, mut world_area) = (0.0f64, 0.0f64);
+        for &m in meshes {
+            let mesh = &scene.meshes[m];
+            corners[m] = mesh
+                .indices
+                .iter()
+                .map(|&i| mesh.lightmap_uvs[i as usize])
+                .collect();
+            for t in mesh.indices.chunks_exact(3) {
+                let [a, b, c] =
+                    [0, 1, 2].map(|k| glam::Vec2::from(mesh.lightmap_uvs[t[k] as usize]));
+                uv_area += f64::from((b - a).perp_dot(c - a).abs() / 2.0);
+                let [p, q, r] = [0, 1, 2].map(|k| {
+                    mesh.transform
+                        .transform_point3(Vec3::from(mesh.vertices[t[k] as usize].position))
+                });
+                world_area += f64::from((q - p).cross(r - p).length() / 2.0);
+            }
+        }
+        let texels = uv_area * f64::from(size) * f64::from(size);
+        Some(Self {
+            width: size,
+            height: size,
+            texels_per_unit: (texels / world_area.max(f64::MIN_POSITIVE)).sqrt() as f32,
+            charts: meshes.len() as u32,
+            utilization: uv_area.min(1.0) as f32,
+            corners,
+            authored: true,
+        })
+    }
+
+    /// The atlas of `uvunwrap` at the highest density that fits one `size` × `size` page.
+    pub fn unwrap(scene: &Scene, meshes: &[usize], size: u32) -> Result<Self> {
         let positions: Vec<Vec<[f32; 3]>> = meshes
             .iter()
             .map(|&m| {
@@ -116,8 +167,23 @@ impl Lightmap {
             charts: atlas.chart_count,
             utilization: atlas.utilization,
             corners,
+            authored: false,
         })
     }
+}
+
+/// The static meshes with triangles, which the lightmap holds.
+pub fn static_meshes(scene: &Scene) -> Result<Vec<usize>> {
+    let meshes: Vec<usize> = (0..scene.meshes.len())
+        .filter(|&m| scene.meshes[m].animation.is_none() && !scene.meshes[m].indices.is_empty())
+        .collect();
+    if meshes.is_empty() {
+        bail!(
+            "{} has no static triangles to place receivers on",
+            scene.source.display()
+        );
+    }
+    Ok(meshes)
 }
 
 /// `indices` with every vertex replaced by the first vertex at the same position.

@@ -105,6 +105,8 @@ pub struct BakeReport {
     pub lightmap: [u32; 2],
     pub texels_per_unit: f32,
     pub charts: u32,
+    /// The lightmap's UVs are the scene's second set (glTF's TEXCOORD_1).
+    pub authored_uvs: bool,
     /// Share of the lightmap's texels that chart surface covers.
     pub utilization: f32,
     pub receivers: usize,
@@ -160,6 +162,24 @@ pub fn static_scene(scene: &Scene) -> Scene {
     out.meshes.retain(|m| m.animation.is_none());
     out.triangle_count = out.meshes.iter().map(|m| m.indices.len() / 3).sum();
     out
+}
+
+/// The receivers of `lightmap`; where the scene's own lightmap UVs put two places under
+/// one texel (charts over each other would share receivers), an atlas of `size` made
+/// instead, with a warning.
+fn place_receivers(scene: &Scene, lightmap: &mut Lightmap, size: u32) -> Result<Receivers> {
+    let receivers = Receivers::place(scene, lightmap);
+    if !lightmap.authored || receivers.overlaps == 0 {
+        return Ok(receivers);
+    }
+    log::warn!(
+        "{}: the scene's lightmap UVs put {} texels under two places; unwrapping an atlas \
+         instead",
+        scene.source.display(),
+        receivers.overlaps
+    );
+    *lightmap = Lightmap::unwrap(scene, &lightmap::static_meshes(scene)?, size)?;
+    Ok(Receivers::place(scene, lightmap))
 }
 
 /// How a bake came about.
@@ -244,9 +264,9 @@ pub fn compute(
         phases.push((name.to_string(), clock.elapsed().as_secs_f64() * 1e3));
         clock = Instant::now();
     };
-    let lightmap = Lightmap::generate(scene, settings.lightmap_size)?;
+    let mut lightmap = Lightmap::generate(scene, settings.lightmap_size)?;
     lap("lightmap UVs");
-    let mut receivers = Receivers::place(scene, &lightmap);
+    let mut receivers = place_receivers(scene, &mut lightmap, settings.lightmap_size)?;
     let offset = 1e-4 * placement::static_bounds(scene).diagonal();
     let host = crate::ray::host::HostRays::of_static(scene);
     let shifted = receivers.shift_out_of_geometry(&host, 32, offset);
@@ -382,6 +402,7 @@ pub fn compute(
         lightmap: [lightmap.width, lightmap.height],
         texels_per_unit: lightmap.texels_per_unit,
         charts: lightmap.charts,
+        authored_uvs: lightmap.authored,
         utilization: lightmap.utilization,
         receivers: receivers.list.len(),
         receivers_inside: receivers.inside(),

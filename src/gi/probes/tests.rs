@@ -827,3 +827,69 @@ fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
         100.0 * mean[0]
     );
 }
+
+/// The scene's own lightmap UVs (glTF's TEXCOORD_1) are the lightmap where every static
+/// mesh has them: given the atlas the bake would make (its texels placed on a square
+/// page) as each vertex's second UV set, the bake keeps it exactly, at the same density
+/// within 1 %, with as many receivers.
+/// UVs that put two places under one texel (the box's floor and ceiling on the same
+/// square) are reported and replaced by the atlas.
+#[test]
+fn the_scenes_own_lightmap_uvs_are_kept_unless_they_overlap() {
+    let scene = cornell();
+    let made = Lightmap::generate(&scene, 128).unwrap();
+    assert!(!made.authored);
+    // The atlas's page is as tall as its charts need: its texels on the 128² page.
+    let square = |[u, v]: [f32; 2]| {
+        [
+            u * made.width as f32 / 128.0,
+            v * made.height as f32 / 128.0,
+        ]
+    };
+    let corners: Vec<Vec<[f32; 2]>> = made
+        .corners
+        .iter()
+        .map(|c| c.iter().map(|&uv| square(uv)).collect())
+        .collect();
+    let mut own = scene.clone();
+    for (m, mesh) in own.meshes.iter_mut().enumerate() {
+        let mut uvs = vec![None; mesh.vertices.len()];
+        for (&i, &uv) in mesh.indices.iter().zip(&corners[m]) {
+            let slot = &mut uvs[i as usize];
+            assert!(slot.is_none_or(|s| s == uv), "a vertex in two charts");
+            *slot = Some(uv);
+        }
+        mesh.lightmap_uvs = uvs.into_iter().map(|uv| uv.unwrap_or([0.0; 2])).collect();
+    }
+    let mut kept = Lightmap::generate(&own, 128).unwrap();
+    assert!(kept.authored);
+    assert_eq!(kept.corners, corners);
+    let density = kept.texels_per_unit / made.texels_per_unit;
+    assert!((density - 1.0).abs() < 0.01, "density {density}");
+    let receivers = super::place_receivers(&own, &mut kept, 128).unwrap();
+    assert!(kept.authored, "valid UVs were replaced");
+    assert_eq!(
+        receivers.list.len(),
+        Receivers::place(&scene, &made).list.len()
+    );
+
+    // Every surface projected from above onto the whole page: the floor, the ceiling and
+    // the blocks' tops over each other.
+    let mut overlapping = scene.clone();
+    let bounds = super::placement::static_bounds(&scene);
+    for mesh in &mut overlapping.meshes {
+        mesh.lightmap_uvs = mesh
+            .vertices
+            .iter()
+            .map(|v| {
+                let p = (Vec3::from(v.position) - bounds.min) / bounds.size();
+                [p.x.clamp(0.0, 1.0), p.z.clamp(0.0, 1.0)]
+            })
+            .collect();
+    }
+    let mut replaced = Lightmap::generate(&overlapping, 128).unwrap();
+    assert!(replaced.authored);
+    let receivers = super::place_receivers(&overlapping, &mut replaced, 128).unwrap();
+    assert!(!replaced.authored, "overlapping UVs were kept");
+    assert_eq!(receivers.overlaps, 0);
+}

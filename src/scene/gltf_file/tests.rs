@@ -416,6 +416,36 @@ fn glb_with_embedded_image_strips_fans_and_mirroring() {
         .ends_with("embedded.glb#image0"));
 }
 
+/// TEXCOORD_1 becomes the mesh's lightmap UVs, vertex for vertex (without
+/// `KHR_texture_transform`, which is the textures'); a primitive without it has none.
+#[test]
+fn the_second_uv_set_is_the_lightmap_uvs() {
+    let dir = TempDir::new("gltf-uv1");
+    let mut f = Fixture::default();
+    let mut with = f.quad(None);
+    let second = [0.1f32, 0.2, 0.4, 0.2, 0.4, 0.6, 0.1, 0.6];
+    with["attributes"]["TEXCOORD_1"] = json!(f.floats(&second, 2));
+    let without = f.quad(None);
+    let doc = json!({
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [with, without]}],
+    });
+    let path = f.write_gltf(&dir.0, "uv1", doc);
+    let (geometry, _) = load(&path).unwrap();
+    let [a, b] = &geometry.meshes[..] else {
+        panic!("{} meshes", geometry.meshes.len());
+    };
+    // Without normals each corner gets a vertex of its own (flat shading), in the
+    // indices' order 0 1 2 0 2 3.
+    let expected: Vec<[f32; 2]> = [0, 1, 2, 0, 2, 3]
+        .map(|i| [second[2 * i], second[2 * i + 1]])
+        .to_vec();
+    assert_eq!(a.lightmap_uvs, expected);
+    assert_eq!(a.lightmap_uvs.len(), a.vertices.len());
+    assert!(b.lightmap_uvs.is_empty());
+}
+
 #[test]
 fn bad_files_name_the_file_and_the_cause() {
     let dir = TempDir::new("gltf-bad");
