@@ -340,8 +340,8 @@ impl Drop for OneShot {
     }
 }
 
-/// Writes `data` (at most 64 KiB) into `buffer` at byte `offset` from the command buffer,
-/// visible to shader reads and writes (and indirect dispatches) in `readers` after it.
+/// Writes `data` into `buffer` at byte `offset` from the command buffer, visible to
+/// shader reads and writes (and indirect dispatches) in `readers` after it.
 pub fn update_buffer(
     ctx: &Context,
     cmd: vk::CommandBuffer,
@@ -350,7 +350,14 @@ pub fn update_buffer(
     data: &[u8],
     readers: vk::PipelineStageFlags2,
 ) {
-    unsafe { ctx.device.cmd_update_buffer(cmd, buffer, offset, data) };
+    // vkCmdUpdateBuffer takes 64 KiB at most.
+    const CHUNK: usize = 65536;
+    for (i, chunk) in data.chunks(CHUNK).enumerate() {
+        unsafe {
+            ctx.device
+                .cmd_update_buffer(cmd, buffer, offset + (i * CHUNK) as u64, chunk)
+        };
+    }
     let mut access = vk::AccessFlags2::SHADER_READ | vk::AccessFlags2::SHADER_WRITE;
     if readers.contains(vk::PipelineStageFlags2::DRAW_INDIRECT) {
         access |= vk::AccessFlags2::INDIRECT_COMMAND_READ;

@@ -551,6 +551,8 @@ pub struct ProbeGi {
     lod_on: bool,
     lod: LevelsOfDetail,
     lod_buffer: Buffer,
+    /// What `lod_buffer` holds (uploaded again only when the levels change).
+    lod_entries: Vec<u32>,
     probes_per_level: [u32; 4],
     /// Referenced by the sets.
     _sampler: Sampler,
@@ -754,7 +756,7 @@ impl ProbeGi {
                 .collect(),
             probe_list: data.cluster_probes.clone(),
         };
-        // Every frame writes its own; level 0 until the first.
+        // Level 0 until a frame finds other levels for its camera.
         let (entries, probes_per_level) = lod.entries(glam::Vec3::ZERO, false);
         let lod_buffer = Buffer::with_data(
             ctx,
@@ -964,6 +966,7 @@ impl ProbeGi {
             lod_on: settings.lod,
             lod,
             lod_buffer,
+            lod_entries: entries,
             probes_per_level,
             _sampler: sampler,
             _sets: descriptor_sets,
@@ -1041,25 +1044,15 @@ impl Technique for ProbeGi {
             vk::PipelineStageFlags2::ALL_TRANSFER,
         );
         let upload = |buffer: vk::Buffer, list: &[u32]| {
-            // vkCmdUpdateBuffer takes 64 KiB at most.
-            const CHUNK: usize = 65536;
-            for (i, chunk) in bytemuck::cast_slice::<u32, u8>(list)
-                .chunks(CHUNK)
-                .enumerate()
-            {
-                update_buffer(
-                    ctx,
-                    cmd,
-                    buffer,
-                    (i * CHUNK) as u64,
-                    chunk,
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                );
-            }
+            let readers = vk::PipelineStageFlags2::COMPUTE_SHADER;
+            update_buffer(ctx, cmd, buffer, 0, bytemuck::cast_slice(list), readers);
         };
         let camera = glam::Vec4::from(frame.uniforms.camera_position).truncate();
         let (entries, per_level) = self.lod.entries(camera, self.lod_on);
-        upload(self.lod_buffer.raw, &entries);
+        if entries != self.lod_entries {
+            upload(self.lod_buffer.raw, &entries);
+            self.lod_entries = entries;
+        }
         self.probes_per_level = per_level;
         // The grid's work where moving meshes are this frame; none without them.
         let (mut listed_vectors, mut listed_receivers) = (0, 0);

@@ -279,7 +279,6 @@ pub fn compute(
         settings.overlaps,
     )?;
     lap("probes");
-    let overlaps = settings.overlaps as usize;
     let rays = SceneRays::new(ctx, scene, 1)?;
     let mut queries = RayQueries::new(ctx, &rays, 1 << 18)?;
     let triangles = Triangles::of(scene, 0.0, |_| true);
@@ -290,29 +289,27 @@ pub fn compute(
         settings.probe_side as usize,
     )?;
     lap("probe rays");
+    let transport_settings = TransportSettings {
+        order: settings.sh_order,
+        rays: settings.receiver_rays as usize,
+        overlaps: settings.overlaps as usize,
+        offset,
+    };
+    let cluster_settings = ClusterSettings {
+        max_error: f64::from(settings.pca_error),
+        max_basis: settings.max_basis as usize,
+        ..ClusterSettings::default()
+    };
     let transport = Transport::compute(
         &mut queries,
         &triangles,
         &receivers.list,
         &probes,
         &views,
-        &TransportSettings {
-            order: settings.sh_order,
-            rays: settings.receiver_rays as usize,
-            overlaps,
-            offset,
-        },
+        &transport_settings,
     )?;
     lap("receiver transport");
-    let clusters = Clusters::build(
-        &receivers.list,
-        &transport,
-        &ClusterSettings {
-            max_error: f64::from(settings.pca_error),
-            max_basis: settings.max_basis as usize,
-            ..ClusterSettings::default()
-        },
-    );
+    let clusters = Clusters::build(&receivers.list, &transport, &cluster_settings);
     lap("clusters");
     // The compression's error where it matters, in the receivers' irradiance from the
     // emitters and the sky: through the clusters against the full transport.
@@ -346,23 +343,10 @@ pub fn compute(
                 &list,
                 &probes,
                 &views,
-                &TransportSettings {
-                    order: settings.sh_order,
-                    rays: settings.receiver_rays as usize,
-                    overlaps,
-                    offset,
-                },
+                &transport_settings,
             )?;
             unsupported_spatial += t.offsets.windows(2).filter(|w| w[0] == w[1]).count();
-            clusters.append(Clusters::build(
-                &list,
-                &t,
-                &ClusterSettings {
-                    max_error: f64::from(settings.pca_error),
-                    max_basis: settings.max_basis as usize,
-                    ..ClusterSettings::default()
-                },
-            ));
+            clusters.append(Clusters::build(&list, &t, &cluster_settings));
             spatial_sky.extend(t.sky);
         }
         (Some(grid), shifted)
