@@ -5,7 +5,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{render_256, shared, temp_dir};
+use common::{probe_furnace, render_256, shared, temp_dir, write};
 use voxcone::compare::{compare, CompareOptions};
 use voxcone::imageio::load_rgb;
 
@@ -111,12 +111,6 @@ fn sponza_and_sibenik_meet_quality_targets() {
     }
 }
 
-fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    path
-}
-
 /// Mean RGB of the centre 8x8 pixels.
 fn centre(path: &Path) -> [f32; 3] {
     let (image, _) = load_rgb(path).unwrap();
@@ -137,24 +131,7 @@ fn centre(path: &Path) -> [f32; 3] {
 #[test]
 fn furnace_closed_box_gathers_wall_radiance() {
     let dir = temp_dir("furnace");
-    write(
-        &dir,
-        "box.mtl",
-        "newmtl wall\nKd 0 0 0\nKe 0.5 0.5 0.5\nnewmtl probe\nKd 1 1 1\n",
-    );
-    // A cube [-1, 1]^3 wound so that every face's normal points inwards, and a small
-    // white probe quad facing +Z in the middle.
-    let obj = "mtllib box.mtl\n\
-        v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
-        v -0.2 -0.2 0\nv 0.2 -0.2 0\nv 0.2 0.2 0\nv -0.2 0.2 0\n\
-        usemtl wall\nf 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n\
-        usemtl probe\nf 9 10 11 12\n";
-    write(&dir, "box.obj", obj);
-    let scene = write(
-        &dir,
-        "furnace.toml",
-        "[camera]\nposition = [0, 0, 0.9]\ntarget = [0, 0, 0]\nfov_y_deg = 10\n[[mesh]]\npath = \"box.obj\"\n",
-    );
+    let scene = probe_furnace(&dir);
     let out = dir.join("furnace.exr");
     render(&scene, "dense", &out);
     let probe = centre(&out);

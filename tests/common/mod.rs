@@ -77,6 +77,38 @@ pub fn render_256(scene: &Path, extra: &[&str], out: &Path) {
     render(scene, &[&["--size", "256x256"], extra].concat(), out);
 }
 
+/// Writes `text` to `dir/name` and returns its path.
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A furnace with a probe, as a scene file in `dir`: a cube [-1, 1]^3 whose walls emit
+/// radiance 0.5 inwards (albedo 0, no lights), a small white quad facing +Z in the
+/// middle, and a narrow camera on it, so that the centre pixels show what the quad
+/// gathers (0.5, exactly).
+pub fn probe_furnace(dir: &Path) -> PathBuf {
+    write(
+        dir,
+        "box.mtl",
+        "newmtl wall\nKd 0 0 0\nKe 0.5 0.5 0.5\nnewmtl probe\nKd 1 1 1\n",
+    );
+    // Every face wound so that its normal points inwards.
+    let obj = "mtllib box.mtl\n\
+        v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+        v -0.2 -0.2 0\nv 0.2 -0.2 0\nv 0.2 0.2 0\nv -0.2 0.2 0\n\
+        usemtl wall\nf 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 4 3 7 8\nf 1 4 8 5\nf 2 6 7 3\n\
+        usemtl probe\nf 9 10 11 12\n";
+    write(dir, "box.obj", obj);
+    write(
+        dir,
+        "furnace.toml",
+        "[camera]\nposition = [0, 0, 0.9]\ntarget = [0, 0, 0]\nfov_y_deg = 10\n\
+         [[mesh]]\npath = \"box.obj\"\n",
+    )
+}
+
 /// Renders `scene` with `--gi path` and `extra` to `out` (EXR), validation clean.
 pub fn render_path(scene: &Path, extra: &[&str], out: &Path) -> RgbImage {
     render(scene, &[&["--gi", "path"], extra].concat(), out);

@@ -1,0 +1,269 @@
+//! The cone tracer's error sources, each on its own, against an analytic case or the path
+//! tracer's one-bounce image. Every render runs with validation and fails on any message.
+//! Those marked `ignore` hold targets the tracer does not meet yet (the reason gives
+//! today's figure); `cargo test --release --test cone_components -- --ignored` runs them.
+
+mod common;
+
+use std::path::Path;
+
+use common::{probe_furnace, render_256, render_path, shared, temp_dir, write};
+use voxcone::imageio::load_rgb;
+
+/// Mean over the channels of the centre 8x8 pixels.
+fn centre(path: &Path) -> f32 {
+    let (image, _) = load_rgb(path).unwrap();
+    let (w, h) = (image.width as usize, image.height as usize);
+    let mut sum = 0.0;
+    for y in h / 2 - 4..h / 2 + 4 {
+        for x in w / 2 - 4..w / 2 + 4 {
+            sum += image.data[(y * w + x) * 3..(y * w + x) * 3 + 3]
+                .iter()
+                .sum::<f32>();
+        }
+    }
+    sum / 192.0
+}
+
+fn dense(scene: &Path, voxels: u32, extra: &[&str], out: &Path) {
+    let voxels = voxels.to_string();
+    render_256(
+        scene,
+        &[&["--gi", "dense", "--voxels", &voxels], extra].concat(),
+        out,
+    );
+}
+
+/// A flat square emitter (radiance 1, albedo 0.5) alone under a black sky, seen from
+/// above: with one bounce its pixel is 1 + 0.5 G, where G, the radiance it gathers, is
+/// 0 (a plane sees none of itself).
+#[test]
+#[ignore = "issue 20: the plane gathers 0.17 of its own radiance at 64³, 0.22 at 128³"]
+fn flat_emitter_gathers_none_of_itself() {
+    let dir = temp_dir("components_plane");
+    write(&dir, "plane.mtl", "newmtl emit\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
+    write(
+        &dir,
+        "plane.obj",
+        "mtllib plane.mtl\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\nusemtl emit\nf 1 2 3 4\n",
+    );
+    let scene = write(
+        &dir,
+        "plane.toml",
+        "[camera]\nposition = [0, 1, 0.01]\ntarget = [0, 0, 0]\nfov_y_deg = 10\n\
+         [[mesh]]\npath = \"plane.obj\"\n",
+    );
+    for voxels in [64, 128] {
+        let out = dir.join(format!("plane_{voxels}.exr"));
+        dense(&scene, voxels, &["--bounces", "1"], &out);
+        let gathered = 2.0 * (centre(&out) - 1.0);
+        eprintln!("flat emitter, {voxels}³: gathers {gathered:.4} of its radiance");
+        assert!(gathered <= 0.02, "{voxels}³: gathers {gathered} of itself");
+    }
+}
+
+/// Inside a closed box whose walls emit L (albedo 0), a white quad gathers L at 64³,
+/// 128³ and 256³, within 2 %.
+#[test]
+#[ignore = "issue 20: 0.953, 0.953 and 0.944 of the walls' radiance"]
+fn furnace_within_two_percent_at_every_resolution() {
+    let dir = temp_dir("components_furnace");
+    let scene = probe_furnace(&dir);
+    for voxels in [64, 128, 256] {
+        let out = dir.join(format!("furnace_{voxels}.exr"));
+        dense(&scene, voxels, &[], &out);
+        let ratio = centre(&out) / 0.5;
+        eprintln!("furnace, {voxels}³: {ratio:.4} of the walls' radiance");
+        assert!((ratio - 1.0).abs() <= 0.02, "{voxels}³: {ratio}");
+    }
+}
+
+/// Two rooms side by side in a box 4 x 2 x 2: the left one's walls emit 1, the right
+/// one's are black, and a white quad in the right room faces the left one. The light
+/// it gathers through a wall between them (two-sided, no thickness, inside one voxel
+/// at every resolution), as a share of what it gathers with the wall taken away.
+fn wall_leak(voxels: u32) -> f32 {
+    let dir = temp_dir(&format!("components_wall_{voxels}"));
+    write(
+        &dir,
+        "rooms.mtl",
+        "newmtl lit\nKd 0 0 0\nKe 1 1 1\nnewmtl dark\nKd 0 0 0\nnewmtl probe\nKd 1 1 1\n",
+    );
+    // The wall at x = 0.02: inside voxel 32 of 64, 64 of 128 (the grid spans 4.16).
+    let x = 0.02;
+    let mut gathered = [0.0; 2];
+    for (i, with_wall) in [false, true].into_iter().enumerate() {
+        let mut obj = String::from("mtllib rooms.mtl\n");
+        let mut quads: Vec<(&str, [[f32; 3]; 4])> = Vec::new();
+        for (mat, x0, x1) in [("lit", -2.0, x), ("dark", x, 2.0)] {
+            quads.push((
+                mat,
+                [[x0, -1., -1.], [x0, -1., 1.], [x1, -1., 1.], [x1, -1., -1.]],
+            ));
+            quads.push((
+                mat,
+                [[x0, 1., -1.], [x1, 1., -1.], [x1, 1., 1.], [x0, 1., 1.]],
+            ));
+            quads.push((
+                mat,
+                [[x0, -1., -1.], [x1, -1., -1.], [x1, 1., -1.], [x0, 1., -1.]],
+            ));
+            quads.push((
+                mat,
+                [[x0, -1., 1.], [x0, 1., 1.], [x1, 1., 1.], [x1, -1., 1.]],
+            ));
+        }
+        quads.push((
+            "lit",
+            [
+                [-2., -1., -1.],
+                [-2., 1., -1.],
+                [-2., 1., 1.],
+                [-2., -1., 1.],
+            ],
+        ));
+        quads.push((
+            "dark",
+            [[2., -1., -1.], [2., -1., 1.], [2., 1., 1.], [2., 1., -1.]],
+        ));
+        if with_wall {
+            quads.push((
+                "dark",
+                [[x, -1., -1.], [x, -1., 1.], [x, 1., 1.], [x, 1., -1.]],
+            ));
+            quads.push((
+                "dark",
+                [[x, -1., -1.], [x, 1., -1.], [x, 1., 1.], [x, -1., 1.]],
+            ));
+        }
+        let s = 0.15;
+        quads.push((
+            "probe",
+            [[1., -s, -s], [1., -s, s], [1., s, s], [1., s, -s]],
+        ));
+        for (q, (mat, corners)) in quads.iter().enumerate() {
+            for c in corners {
+                obj += &format!("v {} {} {}\n", c[0], c[1], c[2]);
+            }
+            let v = 4 * q + 1;
+            obj += &format!("usemtl {mat}\nf {} {} {} {}\n", v, v + 1, v + 2, v + 3);
+        }
+        write(&dir, "rooms.obj", &obj);
+        let scene = write(
+            &dir,
+            "rooms.toml",
+            "[camera]\nposition = [0.4, 0, 0]\ntarget = [1, 0, 0]\nfov_y_deg = 10\n\
+             [[mesh]]\npath = \"rooms.obj\"\n",
+        );
+        let out = dir.join(format!("rooms_{with_wall}.exr"));
+        dense(&scene, voxels, &[], &out);
+        gathered[i] = centre(&out);
+    }
+    let leak = gathered[1] / gathered[0];
+    eprintln!(
+        "thin wall, {voxels}³: {:.4} without it, {:.4} through it: passes {leak:.4}",
+        gathered[0], gathered[1]
+    );
+    leak
+}
+
+#[test]
+#[ignore = "issue 20: the wall passes 0.31 of the light at 64³ and at 128³"]
+fn thin_wall_passes_little_light() {
+    let coarse = wall_leak(64);
+    assert!(coarse <= 0.05, "64³: passes {coarse}");
+    let fine = wall_leak(128);
+    assert!(fine < coarse, "128³ passes {fine}, 64³ {coarse}");
+}
+
+/// The indirect light (the image less its direct light) summed over 32x32 blocks.
+fn block_indirect(image: &Path, direct: &Path) -> Vec<f64> {
+    let (image, _) = load_rgb(image).unwrap();
+    let (direct, _) = load_rgb(direct).unwrap();
+    let w = image.width as usize;
+    let mut blocks = vec![0.0; (w / 32) * (image.height as usize / 32)];
+    for (i, (a, b)) in image.data.chunks(3).zip(direct.data.chunks(3)).enumerate() {
+        let (x, y) = (i % w, i / w);
+        let indirect: f32 = a.iter().zip(b).map(|(a, b)| a - b).sum();
+        blocks[(y / 32) * (w / 32) + x / 32] += f64::from(indirect);
+    }
+    blocks
+}
+
+/// The Cornell box (point light) with one bounce, ours (`--bounces 1`: the voxels hold
+/// direct light only) and the path tracer's (`--max-depth 3`), each less its own direct
+/// light; and ours with all bounces against the 4096-spp reference.
+struct CornellBounces {
+    ours_one: Vec<f64>,
+    ours_all: Vec<f64>,
+    path_one: Vec<f64>,
+    path_all: Vec<f64>,
+}
+
+fn cornell_bounces(name: &str, spp: u32) -> CornellBounces {
+    let shared = shared();
+    let scene = shared.join("reference/cornell_point.scene.json");
+    let dir = temp_dir(name);
+    let path = |f: &str| dir.join(f);
+    render_256(&scene, &["--gi", "off"], &path("off.exr"));
+    render_256(
+        &scene,
+        &["--gi", "dense", "--bounces", "1"],
+        &path("one.exr"),
+    );
+    render_256(&scene, &["--gi", "dense"], &path("all.exr"));
+    let spp = spp.to_string();
+    render_path(
+        &scene,
+        &["--size", "256x256", "--spp", &spp, "--max-depth", "3"],
+        &path("path_one.exr"),
+    );
+    let direct = shared.join("reference/cornell_point_direct.exr");
+    CornellBounces {
+        ours_one: block_indirect(&path("one.exr"), &path("off.exr")),
+        ours_all: block_indirect(&path("all.exr"), &path("off.exr")),
+        path_one: block_indirect(&path("path_one.exr"), &direct),
+        path_all: block_indirect(&shared.join("reference/cornell_point.exr"), &direct),
+    }
+}
+
+/// One bounce, per 32x32 block of the Cornell view, within 10 % of the path tracer's
+/// (blocks where its indirect light is above 2 % of the brightest block's).
+#[test]
+#[cfg_attr(
+    voxcone_shared,
+    ignore = "issue 20: 48 of the 64 blocks within 10 %, from 0.70 to 1.52"
+)]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn one_bounce_per_block_matches_the_path_tracer() {
+    let b = cornell_bounces("components_one_bounce", 512);
+    let brightest = b.path_one.iter().cloned().fold(0.0, f64::max);
+    let mut outside = Vec::new();
+    for (i, (ours, path)) in b.ours_one.iter().zip(&b.path_one).enumerate() {
+        if *path > 0.02 * brightest && (ours / path - 1.0).abs() > 0.1 {
+            outside.push((i, ours / path));
+        }
+    }
+    eprintln!("one bounce: blocks off by more than 10 %: {outside:?}");
+    assert!(
+        outside.is_empty(),
+        "{} blocks off: {outside:?}",
+        outside.len()
+    );
+}
+
+/// All bounces over the first: the voxel bounces gather as the path tracer's do, within
+/// 5 % (measured 1.908 against 1.866: 1.023).
+#[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn bounces_over_the_first_match_the_path_tracer() {
+    let b = cornell_bounces("components_bounces", 128);
+    let total = |v: &[f64]| v.iter().sum::<f64>();
+    let ours = total(&b.ours_all) / total(&b.ours_one);
+    let path = total(&b.path_all) / total(&b.path_one);
+    eprintln!("all bounces over the first: ours {ours:.4}, path tracer {path:.4}");
+    assert!(
+        (ours / path - 1.0).abs() <= 0.05,
+        "ours {ours}, path {path}"
+    );
+}
