@@ -6,8 +6,10 @@ use anyhow::{anyhow, bail, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use crate::gi::path::cli::PathArgs;
+use crate::gi::path::ConeComponent;
 use crate::gi::probes::cli::ProbeArgs;
 use crate::gi::vct::cli::VctArgs;
+use crate::gi::vct::ConeSettings;
 use crate::gi::{DebugView, GiSettings};
 use crate::passes::shadow::ShadowResolution;
 use crate::scene::{GiOverrides, LoadOptions, Scene};
@@ -139,6 +141,13 @@ pub struct CommonArgs {
     /// Scene time in seconds (animation).
     #[arg(long, default_value_t = 0.0, value_parser = parse_finite)]
     pub time: f32,
+    /// One diffuse cone of the cone tracer's gather as a component reference: K = 0 the
+    /// cone along the normal, 1 to --diffuse-cones - 1 the ring's. --gi dense and --gi
+    /// octree trace that cone alone for the indirect light (albedo times its radiance);
+    /// --gi path shows albedo times the exact mean radiance within it (one bounce with
+    /// --max-depth 3), instead of the image.
+    #[arg(long)]
+    pub cone: Option<u32>,
 }
 
 #[derive(Args, Debug)]
@@ -348,6 +357,18 @@ impl CommonArgs {
         }
     }
 
+    /// `--cone`, checked against the gather's cones.
+    fn cone_component(&self, cones: &ConeSettings) -> Result<Option<u32>> {
+        match self.cone {
+            Some(k) if k >= cones.diffuse_cones => bail!(
+                "--cone {k}: the diffuse gather has cones 0 to {} (--diffuse-cones {})",
+                cones.diffuse_cones - 1,
+                cones.diffuse_cones
+            ),
+            cone => Ok(cone),
+        }
+    }
+
     /// The settings of a frame: the command line over the scene file's `[gi]` over the
     /// defaults.
     pub fn render_settings(&self, scene: &GiOverrides) -> Result<RenderSettings> {
@@ -365,6 +386,9 @@ impl CommonArgs {
                 bail!("{option} sets the irradiance probes: it needs --gi probes");
             }
         }
+        if self.cone.is_some() && matches!(self.gi, GiMode::Off | GiMode::Probes) {
+            bail!("--cone is a cone of the cone tracer's gather: it needs --gi dense, --gi octree or --gi path");
+        }
         if !matches!(self.gi, GiMode::Dense | GiMode::Octree) {
             if let Some(option) = self.vct.given().first() {
                 bail!("{option} works on the voxels: it needs --gi dense or --gi octree");
@@ -376,11 +400,21 @@ impl CommonArgs {
                 if !octree && self.debug_view == DebugView::OctreeNodes {
                     bail!("--debug-view octree-nodes shows the octree: it needs --gi octree");
                 }
-                GiSettings::ConeTracing(self.vct.settings(octree, scene)?)
+                let mut settings = self.vct.settings(octree, scene)?;
+                settings.cones.only_cone = self.cone_component(&settings.cones)?;
+                GiSettings::ConeTracing(settings)
             }
             GiMode::Path => {
-                let settings = self.path.settings(scene, self.is_reference());
+                let mut settings = self.path.settings(scene, self.is_reference());
                 settings.check()?;
+                // The gather's layout as the cone tracer's settings give it (the scene
+                // file's [gi] over the defaults).
+                let cones = self.vct.settings(false, scene)?.cones;
+                settings.cone = self.cone_component(&cones)?.map(|index| ConeComponent {
+                    index,
+                    ring: cones.diffuse_cones - 1,
+                    aperture_deg: cones.diffuse_aperture_deg,
+                });
                 GiSettings::Path(settings)
             }
             GiMode::Probes => {

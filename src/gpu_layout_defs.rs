@@ -526,8 +526,8 @@ gpu_layout! {
         uint wide_steps_by_level,
         /// 1: the dense grid's compact pass adds the static meshes' fragment sums (`BINDING_DENSE_STATIC_SUMS`) to this frame's (a scene with moving meshes, static meshes voxelized once).
         uint static_sums,
-        /// Pads the struct to a multiple of 16 bytes.
-        uint pad0,
+        /// The one diffuse cone the screen's gather traces, its radiance alone (`--cone`: 0 along the normal, 1.. the ring's), or 0xffffffff for the whole gather.
+        uint only_cone,
         /// Pads the struct to a multiple of 16 bytes.
         uint pad1,
         /// Pads the struct to a multiple of 16 bytes.
@@ -800,6 +800,14 @@ gpu_layout! {
         uint seed,
         /// 1: cut-outs stop shadow rays whatever their coverage (the references' convention: their next-event estimation ignores Mitsuba's masks).
         uint opaque_shadow_cut_outs,
+        /// The cone component (`--cone`): the camera's hit gathers albedo times the mean radiance within the cone tracer's diffuse cone `cone` (0 along the normal, 1..`ring` the ring's), sampled uniformly, instead of its light; 0xffffffff for none.
+        uint cone,
+        /// Cones in the diffuse gather's ring.
+        uint ring,
+        /// cos of the diffuse cones' half aperture.
+        float cone_cos_half,
+        /// Pads the struct to a multiple of 16 bytes.
+        uint pad0,
     }
 
     /// Push constants of the path tracer: this dispatch's share of the samples.

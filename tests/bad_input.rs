@@ -235,6 +235,23 @@ fn bad_bake_settings_and_scenes() {
     );
 }
 
+/// `--cone` names a cone of the gather, with a technique that has one.
+#[test]
+fn bad_cone_component() {
+    assert_fails_naming(
+        &["render", "--cone", "6", "-o", "x.png"],
+        &["--cone 6", "cones 0 to 5"],
+    );
+    assert_fails_naming(
+        &["render", "--gi", "path", "--cone", "6", "-o", "x.png"],
+        &["--cone 6", "cones 0 to 5"],
+    );
+    assert_fails_naming(
+        &["render", "--gi", "off", "--cone", "0", "-o", "x.png"],
+        &["--cone", "needs --gi dense, --gi octree or --gi path"],
+    );
+}
+
 #[test]
 fn bad_probe_settings() {
     assert_fails_naming(

@@ -10,6 +10,7 @@
 // directional lights in the lighting pass's units, a constant sky, a box pixel filter,
 // Russian roulette from `rr_depth` on. Each invocation adds `samples_now` samples to its
 // pixel's running mean and writes it to the screen radiance.
+#include "common/diffuse_cones.glsl"
 #include "common/direct_light.glsl"
 #include "common/random.glsl"
 #include "common/subgroup_add.glsl"
@@ -127,6 +128,17 @@ vec3 sample_cosine(vec3 n, inout uint rng) {
     vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
     vec3 b = cross(n, t);
     return normalize(r * cos(phi) * t + r * sin(phi) * b + sqrt(max(1.0 - r * r, 0.0)) * n);
+}
+
+// A direction uniform in solid angle within the cone about `axis` of half-angle
+// acos(cos_half).
+vec3 sample_cone(vec3 axis, float cos_half, inout uint rng) {
+    float c = 1.0 - random_next(rng) * (1.0 - cos_half);
+    float s = sqrt(max(1.0 - c * c, 0.0));
+    float phi = 6.2831853 * random_next(rng);
+    vec3 t = perpendicular(axis);
+    vec3 b = cross(axis, t);
+    return normalize(s * cos(phi) * t + s * sin(phi) * b + c * axis);
 }
 
 // The Blinn-Phong exponent of the lighting pass's lobe for `roughness`.
@@ -301,6 +313,12 @@ Path start_path(uvec2 pixel, uint index) {
     return p;
 }
 
+// The cone component (`--cone`): the camera's hit gathers albedo times the radiance
+// from one cone of the cone tracer's gather, instead of its own light.
+bool cone_component(Path p) {
+    return p.depth == 1u && path.cone != 0xffffffffu;
+}
+
 // Russian roulette from `rr_depth` on: whether the path goes on, its throughput raised
 // by the chance it had.
 bool survives(inout Path p) {
@@ -324,7 +342,7 @@ bool extend(inout Path p) {
         return false;
     }
     Surface s = surface_at(hit, p.dir);
-    if (any(greaterThan(s.emitted, vec3(0.0)))) {
+    if (any(greaterThan(s.emitted, vec3(0.0))) && !cone_component(p)) {
         float weight = 1.0;
         RayTriangle tri = ray_triangle(hit.triangle);
         bool sampled = (floatBitsToUint(tri.e2.w) & RAY_MOVING) == 0u && rays.emitter_count > 0u;
@@ -338,6 +356,20 @@ bool extend(inout Path p) {
     uint max_depth = path.max_depth == 0u ? 0xffffffffu : path.max_depth;
     if (p.depth >= max_depth) {
         return false;
+    }
+    if (cone_component(p)) {
+        vec3 next = sample_cone(diffuse_cone_axis(s.ns, int(path.cone), int(path.ring)), path.cone_cos_half, p.rng);
+        if (dot(s.ng, next) <= 0.0) {
+            return false;
+        }
+        // Uniform within the cone: the mean radiance over it, times albedo as the
+        // composite multiplies the gathered light.
+        p.throughput *= s.albedo;
+        p.bsdf_pdf = 0.0;
+        p.origin = s.p + s.ng * rays.epsilon;
+        p.dir = next;
+        p.depth++;
+        return true;
     }
     if (s.transmit > 0.0 && random_next(p.rng) < s.transmit) {
         // The light passing the surface, refracted (reflected where it cannot leave):

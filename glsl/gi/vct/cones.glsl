@@ -3,6 +3,7 @@
 #ifndef CONES_GLSL
 #define CONES_GLSL
 #include "common/frame.glsl"
+#include "common/diffuse_cones.glsl"
 #include "gi/vct/sampling.glsl"
 
 // Per axis, the share of a cell of directional `level` centred at `uvw` (two cells
@@ -206,12 +207,6 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
     return 1.0 - occlusion;
 }
 
-// A unit vector perpendicular to the unit vector `axis` (from the world's y axis, or x
-// where `axis` nearly is y): with cross(axis, it), the frame that cones are laid out in.
-vec3 perpendicular(vec3 axis) {
-    return normalize(abs(axis.y) < 0.9 ? cross(axis, vec3(0.0, 1.0, 0.0)) : cross(axis, vec3(1.0, 0.0, 0.0)));
-}
-
 // The screen's ring cones are each traced as sub-cones, narrower cones around their
 // axis that read finer levels: a 60-degree cone leaving a surface blends, in its coarse
 // cells, the surface's own lit voxels and walls seen edge-on that its rays never meet,
@@ -245,35 +240,36 @@ vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surfa
 }
 
 // Cosine-weighted mean radiance over the hemisphere around n of the surface at `surface`
-// from `cones` cones starting at `origin`: one along n, the others in a ring 57.5 degrees
-// from it (traced as sub-cones where `split_ring`: the screen's), each stepping
-// `step_factor` of its diameter. With `with_ao`, alpha is the ambient occlusion (1 where
-// nothing near occludes); else 1.
-// The ring at 57.5 degrees: with the exact cone integrals the best ring is 50-55 degrees
-// (the cosine-weighted mean direction of the band it stands for is 54.7), but the traced
-// cones read their ring best at 57.5 (a sweep of 54.7 to 60 degrees with sub-cones,
-// BENCHMARKS.md, session 11).
+// from `cones` cones starting at `origin` (diffuse_cone_axis), each stepping
+// `step_factor` of its diameter, the ring's traced as sub-cones where `split_ring` (the
+// screen's). With `with_ao`, alpha is the ambient occlusion (1 where nothing near
+// occludes); else 1. With `only` (0..cones-1), the radiance that cone alone gathers
+// instead (`--cone`: a component against the path tracer's exact cone integral).
 vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod, bool with_ao, float step_factor,
-                    bool split_ring) {
-    vec3 t = perpendicular(n);
-    vec3 b = cross(n, t);
+                    bool split_ring, int only) {
     int ao_volume = -1;
     if (with_ao) {
         vec3 m = abs(n);
         int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
         ao_volume = 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
     }
-    vec4 centre = trace_cone(origin, n, vct.diffuse_tan_half, min_lod, surface, n, ao_volume, step_factor);
     int ring = cones - 1;
+    int parts = split_ring ? (ring <= 5 ? 4 : (ring <= 10 ? 2 : 1)) : 1;
+    if (only == 0) {
+        return vec4(trace_cone(origin, n, vct.diffuse_tan_half, min_lod, surface, n, -1, step_factor).rgb, 1.0);
+    }
+    if (only > 0) {
+        vec3 dir = diffuse_cone_axis(n, only, ring);
+        return vec4(trace_ring_cone(origin, dir, parts, min_lod, surface, n, step_factor, -1).rgb, 1.0);
+    }
+    vec4 centre = trace_cone(origin, n, vct.diffuse_tan_half, min_lod, surface, n, ao_volume, step_factor);
     if (ring == 0) {
         return vec4(centre.rgb, 1.0 - centre.a);
     }
-    int parts = split_ring ? (ring <= 5 ? 4 : (ring <= 10 ? 2 : 1)) : 1;
     vec4 around = vec4(0.0);
-    for (int i = 0; i < ring; i++) {
-        float phi = 6.2831853 * float(i) / float(ring);
-        vec3 dir = normalize(0.5373 * n + 0.8434 * (cos(phi) * t + sin(phi) * b));
-        around += trace_ring_cone(origin, dir, parts, min_lod, surface, n, step_factor, ao_volume);
+    for (int i = 1; i <= ring; i++) {
+        around += trace_ring_cone(origin, diffuse_cone_axis(n, i, ring), parts, min_lod, surface, n, step_factor,
+                                  ao_volume);
     }
     // Cosine weights: a cone of half-angle 30 degrees at angle a from n holds
     // pi sin^2(30) cos(a) of the cosine-weighted hemisphere: pi/4 along n, about pi/8 in

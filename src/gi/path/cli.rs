@@ -44,6 +44,7 @@ impl PathArgs {
             max_depth: self.max_depth.or(scene.max_depth),
             seed: self.seed.unwrap_or(d.seed),
             opaque_shadow_cut_outs: reference,
+            cone: None,
         }
     }
 }

@@ -43,8 +43,20 @@ const MAX_SAMPLES_PER_FRAME: u32 = 1024;
 /// path per pixel, which fits many times over; a frame then records several.
 const CPU_SAMPLES_PER_DISPATCH: u32 = 1;
 
+/// One diffuse cone of the cone tracer's gather, for the path tracer to integrate
+/// exactly (`--cone`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConeComponent {
+    /// 0: the cone along the normal; 1..=`ring`: the ring's.
+    pub index: u32,
+    /// Cones in the gather's ring.
+    pub ring: u32,
+    /// Full aperture, degrees.
+    pub aperture_deg: f32,
+}
+
 /// The path tracer's settings.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathSettings {
     /// Samples per pixel to converge to.
     pub spp: u32,
@@ -58,6 +70,10 @@ pub struct PathSettings {
     /// estimation (camera and bounce rays pass cut-outs with the probability 1 -
     /// coverage either way).
     pub opaque_shadow_cut_outs: bool,
+    /// Instead of the image, albedo times the mean radiance within this cone of the cone
+    /// tracer's gather at each camera hit, its directions sampled uniformly: the exact
+    /// value of the one cone `--gi dense --cone` traces.
+    pub cone: Option<ConeComponent>,
 }
 
 impl Default for PathSettings {
@@ -67,6 +83,7 @@ impl Default for PathSettings {
             max_depth: None,
             seed: 0,
             opaque_shadow_cut_outs: false,
+            cone: None,
         }
     }
 }
@@ -153,6 +170,12 @@ impl PathTracer {
             rr_depth: RR_DEPTH,
             seed: settings.seed,
             opaque_shadow_cut_outs: u32::from(settings.opaque_shadow_cut_outs),
+            cone: settings.cone.map_or(u32::MAX, |c| c.index),
+            ring: settings.cone.map_or(0, |c| c.ring),
+            cone_cos_half: settings
+                .cone
+                .map_or(1.0, |c| (c.aperture_deg.to_radians() * 0.5).cos()),
+            ..Default::default()
         };
         let uniforms = Buffer::with_data(
             ctx,

@@ -139,6 +139,7 @@ impl VctArgs {
                 .ao_distance
                 .or(scene.ao_distance_voxels)
                 .unwrap_or(d.ao_distance_voxels),
+            only_cone: None,
         };
         cones.check()?;
         let voxels = self.voxels.or(scene.voxels).unwrap_or(DEFAULT_VOXELS);

@@ -375,6 +375,7 @@ impl<S: VoxelStore> ConeTracing<S> {
             ao_distance: cones.ao_distance_voxels.max(1e-3) * grid.voxel_size,
             wide_steps_by_level: u32::from(cones.wide_steps_by_level),
             static_sums: u32::from(store.static_sums()),
+            only_cone: cones.only_cone.unwrap_or(u32::MAX),
             ..Default::default()
         };
         let uniforms = Buffer::with_data(

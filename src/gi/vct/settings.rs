@@ -76,6 +76,10 @@ pub struct ConeSettings {
     pub shadow_aperture_deg: f32,
     /// Ambient occlusion halves for occluders this many voxels away.
     pub ao_distance_voxels: f32,
+    /// The one diffuse cone the screen's gather traces, its radiance alone (0 along the
+    /// normal, 1.. the ring's): a component to compare with the path tracer's exact
+    /// integral over the same cone (`--cone`).
+    pub only_cone: Option<u32>,
 }
 
 impl ConeSettings {
@@ -175,6 +179,7 @@ impl Default for ConeSettings {
             accumulate_bounces: true,
             shadow_aperture_deg: 4.0,
             ao_distance_voxels: 4.0,
+            only_cone: None,
         }
     }
 }

@@ -46,7 +46,7 @@ void main() {
     const bool with_ao = false;
 #endif
     vec3 start = p + n * (2.0 * vct.origin.w);
-    imageStore(indirect, low, gather_diffuse(p, start, n, int(vct.diffuse_cones), 1.0, with_ao, vct.step_factor, true));
+    imageStore(indirect, low, gather_diffuse(p, start, n, int(vct.diffuse_cones), 1.0, with_ao, vct.step_factor, true, int(vct.only_cone)));
     // Soft shadows change at the scale of the voxels, like the indirect light: their
     // cones are traced here too, four lights to a band of rows.
     if ((frame.flags & FLAG_SHADOW_CONES) != 0u) {

@@ -28,7 +28,7 @@ void main() {
     n = length(n) > 0.2 ? normalize(n) : vec3(0.0, 1.0, 0.0);
     vec3 p = voxel_center(entry.voxel);
     float offset = 1.5 * vct.origin.w;
-    vec3 gathered = gather_diffuse(p, p + n * offset, n, BOUNCE_CONES, 1.0, false, vct.bounce_step_factor, false).rgb;
+    vec3 gathered = gather_diffuse(p, p + n * offset, n, BOUNCE_CONES, 1.0, false, vct.bounce_step_factor, false, -1).rgb;
     vec4 direct = imageLoad(voxel_direct, voxel);
 #ifdef OCTREE
     if (fresh_brick(entry)) {
