@@ -407,14 +407,16 @@ impl CommonArgs {
             GiMode::Path => {
                 let mut settings = self.path.settings(scene, self.is_reference());
                 settings.check()?;
-                // The gather's layout as the cone tracer's settings give it (the scene
-                // file's [gi] over the defaults).
-                let cones = self.vct.settings(false, scene)?.cones;
-                settings.cone = self.cone_component(&cones)?.map(|index| ConeComponent {
-                    index,
-                    ring: cones.diffuse_cones - 1,
-                    aperture_deg: cones.diffuse_aperture_deg,
-                });
+                if self.cone.is_some() {
+                    // The gather's layout as the cone tracer's settings give it (the
+                    // scene file's [gi] over the defaults).
+                    let cones = self.vct.settings(false, scene)?.cones;
+                    settings.cone = self.cone_component(&cones)?.map(|index| ConeComponent {
+                        index,
+                        ring: cones.diffuse_cones - 1,
+                        aperture_deg: cones.diffuse_aperture_deg,
+                    });
+                }
                 GiSettings::Path(settings)
             }
             GiMode::Probes => {

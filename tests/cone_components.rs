@@ -7,7 +7,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{probe_furnace, render, render_256, render_path, shared, temp_dir, write};
+use common::{flat_plane, probe_furnace, render, render_256, render_path, shared, temp_dir, write};
 use voxcone::imageio::load_rgb;
 
 /// Mean over the channels of the centre 8x8 pixels.
@@ -41,18 +41,7 @@ fn dense(scene: &Path, voxels: u32, extra: &[&str], out: &Path) {
 #[ignore = "issue 20: the plane gathers 0.17 of its own radiance at 64³, 0.22 at 128³"]
 fn flat_emitter_gathers_none_of_itself() {
     let dir = temp_dir("components_plane");
-    write(&dir, "plane.mtl", "newmtl emit\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
-    write(
-        &dir,
-        "plane.obj",
-        "mtllib plane.mtl\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\nusemtl emit\nf 1 2 3 4\n",
-    );
-    let scene = write(
-        &dir,
-        "plane.toml",
-        "[camera]\nposition = [0, 1, 0.01]\ntarget = [0, 0, 0]\nfov_y_deg = 10\n\
-         [[mesh]]\npath = \"plane.obj\"\n",
-    );
+    let scene = flat_plane(&dir, "Kd 0.5 0.5 0.5\nKe 1 1 1\n", 10.0, "");
     for voxels in [64, 128] {
         let out = dir.join(format!("plane_{voxels}.exr"));
         dense(&scene, voxels, &["--bounces", "1"], &out);

@@ -5,7 +5,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{probe_furnace, render_256, shared, temp_dir, write};
+use common::{flat_plane, probe_furnace, render_256, shared, temp_dir, write};
 use voxcone::compare::{compare, CompareOptions};
 use voxcone::imageio::load_rgb;
 
@@ -151,17 +151,11 @@ fn furnace_closed_box_gathers_wall_radiance() {
 #[test]
 fn open_plane_gathers_the_sky() {
     let dir = temp_dir("sky");
-    write(&dir, "plane.mtl", "newmtl white\nKd 1 1 1\n");
-    write(
+    let scene = flat_plane(
         &dir,
-        "plane.obj",
-        "mtllib plane.mtl\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\nusemtl white\nf 1 2 3 4\n",
-    );
-    let scene = write(
-        &dir,
-        "sky.toml",
-        "[camera]\nposition = [0, 1, 0.01]\ntarget = [0, 0, 0]\nfov_y_deg = 20\n\
-         [[mesh]]\npath = \"plane.obj\"\n[sky]\nradiance = [0.2, 0.3, 0.4]\n",
+        "Kd 1 1 1\n",
+        20.0,
+        "[sky]\nradiance = [0.2, 0.3, 0.4]\n",
     );
     // With ambient occlusion on the indirect light too: nothing occludes the plane.
     for extra in [&[][..], &["--ao"][..]] {

@@ -84,6 +84,26 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     path
 }
 
+/// A flat square [-1, 1]² at y = 0 facing up, of the MTL statements `material`, seen from
+/// a camera 1 above its centre with the vertical field of view `fov_y_deg`, as a scene
+/// file in `dir` with `extra` appended (a `[sky]` table, say).
+pub fn flat_plane(dir: &Path, material: &str, fov_y_deg: f32, extra: &str) -> PathBuf {
+    write(dir, "plane.mtl", &format!("newmtl plane\n{material}"));
+    write(
+        dir,
+        "plane.obj",
+        "mtllib plane.mtl\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\nusemtl plane\nf 1 2 3 4\n",
+    );
+    write(
+        dir,
+        "plane.toml",
+        &format!(
+            "[camera]\nposition = [0, 1, 0.01]\ntarget = [0, 0, 0]\nfov_y_deg = {fov_y_deg}\n\
+             [[mesh]]\npath = \"plane.obj\"\n{extra}"
+        ),
+    )
+}
+
 /// A furnace with a probe, as a scene file in `dir`: a cube [-1, 1]^3 whose walls emit
 /// radiance 0.5 inwards (albedo 0, no lights), a small white quad facing +Z in the
 /// middle, and a narrow camera on it, so that the centre pixels show what the quad

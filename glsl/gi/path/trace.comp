@@ -125,7 +125,7 @@ float mis_weight(float a, float b) {
 vec3 sample_cosine(vec3 n, inout uint rng) {
     float r = sqrt(random_next(rng));
     float phi = 6.2831853 * random_next(rng);
-    vec3 t = normalize(abs(n.y) < 0.9 ? cross(n, vec3(0.0, 1.0, 0.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
+    vec3 t = perpendicular(n);
     vec3 b = cross(n, t);
     return normalize(r * cos(phi) * t + r * sin(phi) * b + sqrt(max(1.0 - r * r, 0.0)) * n);
 }
@@ -184,7 +184,7 @@ vec3 sample_bsdf(Surface s, inout uint rng) {
     float cos_h = pow(random_next(rng), 1.0 / (e + 1.0));
     float sin_h = sqrt(max(1.0 - cos_h * cos_h, 0.0));
     float phi = 6.2831853 * random_next(rng);
-    vec3 t = normalize(abs(s.ns.y) < 0.9 ? cross(s.ns, vec3(0.0, 1.0, 0.0)) : cross(s.ns, vec3(1.0, 0.0, 0.0)));
+    vec3 t = perpendicular(s.ns);
     vec3 b = cross(s.ns, t);
     vec3 h = sin_h * cos(phi) * t + sin_h * sin(phi) * b + cos_h * s.ns;
     return reflect(-s.v, h);
@@ -358,7 +358,9 @@ bool extend(inout Path p) {
         return false;
     }
     if (cone_component(p)) {
-        vec3 next = sample_cone(diffuse_cone_axis(s.ns, int(path.cone), int(path.ring)), path.cone_cos_half, p.rng);
+        vec3 t = perpendicular(s.ns);
+        vec3 axis = diffuse_cone_axis(s.ns, t, cross(s.ns, t), int(path.cone), int(path.ring));
+        vec3 next = sample_cone(axis, path.cone_cos_half, p.rng);
         if (dot(s.ng, next) <= 0.0) {
             return false;
         }
