@@ -399,6 +399,16 @@ gpu_layout! {
         /// then (from `probe_count` on) per cluster, the coefficients of each probe its basis
         /// vectors read.
         BINDING_PROBE_LOD = 29;
+        /// Irradiance probes (set 3): mips 1 to 3 of this frame's lightmap (Sedláček 2019,
+        /// 4.2.3), an array of three `rgba16f` storage images.
+        BINDING_PROBE_LIGHTMAP_LEVELS = 30;
+        /// Irradiance probes (set 3): what this frame computes of the lightmap
+        /// (`gi::probes::levels`), `uint[]` storage buffer: the counts of the receivers and of
+        /// the coarser levels' texels listed, then the receivers' indices, then per texel its
+        /// coordinates (x | y << 16) and its receiver with its level (receiver | level << 30).
+        BINDING_PROBE_WORK = 31;
+        /// Irradiance probes (set 3): `ProbeView` uniform buffer.
+        BINDING_PROBE_VIEW = 32;
         /// Workgroup size of the probe passes.
         PROBE_GROUP_SIZE = 64;
 
@@ -846,6 +856,16 @@ gpu_layout! {
         vec4 grid_min,
         /// One over the grid's box's extent (xyz; 0 along a flat axis).
         vec4 grid_inverse_extent,
+    }
+
+    /// Where this frame's and the last frame's lightmaps are fine (Sedláček 2019, 4.2.4).
+    struct ProbeView {
+        /// This frame's camera (xyz) and whether the level of detail is on (w: 1 or 0).
+        vec4 camera,
+        /// The last frame's, the same way.
+        vec4 previous_camera,
+        /// The distances where the lightmap's levels 1, 2 and 3 begin (xyz).
+        vec4 distances,
     }
 
     /// Push constants of every mesh draw.

@@ -1,6 +1,7 @@
 #version 460
 // The probes' gather (Sedláček 2019, 3.3.2): at each reduced-resolution pixel, the
-// lightmap read bilinearly at the uv of the G-buffer's triangle there. The receivers
+// lightmap read bilinearly at the uv of the G-buffer's triangle there, at the level its
+// distance from the camera gives (4.2.4). The receivers
 // cover every texel a chart's bilinear footprint reaches (`receivers.rs`), so no seam
 // reads an empty texel. Moving meshes have no lightmap: they read the grid of spatial
 // receivers (4.1.2) at their position, its six directions weighted by the normal. The
@@ -103,11 +104,14 @@ void main() {
         vec2 bary = barycentrics(ray_triangle(i), p);
         vec2 at = lightmap_uv(i, bary);
         if (at.x >= 0.0) {
-            e = textureLod(lightmap, at, 0.0).rgb;
+            float level = lightmap_level(p, view.camera);
+            e = textureLod(lightmap, at, level).rgb;
             ivec2 size = textureSize(lightmap, 0);
             ivec2 texel = clamp(ivec2(at * vec2(size)), ivec2(0), size - 1);
             if (frame.debug_view == DEBUG_LIGHTMAP) {
-                debug = texelFetch(lightmap, texel, 0).rgb;
+                int mip = int(level);
+                ivec2 mip_size = textureSize(lightmap, mip);
+                debug = texelFetch(lightmap, clamp(ivec2(at * vec2(mip_size)), ivec2(0), mip_size - 1), mip).rgb;
             } else if (frame.debug_view == DEBUG_CLUSTERS) {
                 uint c = texelFetch(texel_clusters, texel.y * size.x + texel.x).r;
                 debug = c == RAY_NONE ? vec3(0.0) : index_colour(c);

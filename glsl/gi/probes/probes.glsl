@@ -9,6 +9,32 @@ layout(set = SET_GI, binding = BINDING_PROBE_UNIFORMS) uniform ProbeBlock {
     ProbeUniforms probes;
 };
 layout(set = SET_GI, binding = BINDING_PROBE_CORNER_UVS) uniform samplerBuffer corner_uvs;
+layout(set = SET_GI, binding = BINDING_PROBE_VIEW) uniform ViewBlock {
+    ProbeView view;
+};
+
+// The lightmap level a lookup at `p` reads for a camera at `camera` (xyz; w: the level of
+// detail is on), fractional (Sedláček 2019, 4.2.4): level k from distance k on, blended
+// in from the finer level over the last quarter of the span before it. The clusters'
+// levels (`frame.rs`) step at the same distances, and a surface is no nearer the camera
+// than its cluster's box, so a lookup never reads a level finer than its cluster computed:
+// the blend only ever reaches towards the coarser level (the thesis's smoothing), and it
+// ends where the coarser level begins (its shifted distance for fragments).
+float lightmap_level(vec3 p, vec4 camera) {
+    if (camera.w == 0.0) {
+        return 0.0;
+    }
+    float d = distance(p, camera.xyz);
+    float level = 0.0;
+    float start = 0.0;
+    for (int k = 0; k < 3; k++) {
+        float begins = view.distances[k];
+        float width = 0.25 * (begins - start);
+        level += clamp((d - begins + width) / width, 0.0, 1.0);
+        start = begins;
+    }
+    return level;
+}
 
 // The lightmap uv of scene triangle `i` at barycentrics `bary`; negative where the
 // triangle has none (a moving mesh's).
@@ -52,6 +78,11 @@ layout(set = SET_GI, binding = BINDING_PROBE_RECEIVERS) uniform usamplerBuffer r
 layout(set = SET_GI, binding = BINDING_PROBE_COORDINATES) uniform samplerBuffer coordinates;
 layout(set = SET_GI, binding = BINDING_PROBE_BASIS, std430) readonly buffer BasisBlock {
     vec4 basis[];
+};
+
+// What this frame computes of the lightmap (`BINDING_PROBE_WORK`).
+layout(set = SET_GI, binding = BINDING_PROBE_WORK, std430) readonly buffer WorkBlock {
+    uint work[];
 };
 
 vec3 receiver_irradiance(uint r) {

@@ -7,7 +7,9 @@
 // - the direct light of every light, shadowed by the frame's shadow maps, × albedo / π;
 // - the emission, from the front of an emitter only (one-sided, as the G-buffer);
 // - last frame's lightmap (irradiance / π) × albedo: each frame adds a bounce, as the
-//   cone tracer's voxel bounces do;
+//   cone tracer's voxel bounces do; read at the coarser of the levels this frame's and
+//   last frame's camera give the hit (4.2.1's first solution), so that it reads what the
+//   frame that wrote it computed, whichever camera that was;
 // and the sky where a ray leaves the scene. Normal maps and specular lobes are not
 // seen by the probes (their lightmap is diffuse irradiance). What each ray met was
 // decoded once (`surfaces.comp`).
@@ -59,7 +61,8 @@ vec3 radiance_along(uint ray) {
     }
     vec3 radiance = albedo / PI * irradiance + vec3(unpackHalf2x16(b.z), unpackHalf2x16(b.w).x);
     if (probes.bounces != 0u && b.y != NO_LIGHTMAP_UV) {
-        radiance += albedo * textureLod(previous_lightmap, unpackUnorm2x16(b.y), 0.0).rgb;
+        float level = max(lightmap_level(p, view.camera), lightmap_level(p, view.previous_camera));
+        radiance += albedo * textureLod(previous_lightmap, unpackUnorm2x16(b.y), level).rgb;
     }
     return radiance;
 }

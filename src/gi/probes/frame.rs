@@ -6,6 +6,9 @@
 //!   onto the harmonics (λ);
 //! - `probe_basis`: each cluster's basis vectors from its probes' λ;
 //! - `probe_receivers`: each receiver's irradiance into the lightmap;
+//! - `probe_levels`: the lightmap's coarser levels from the receivers that stand for their
+//!   texels (4.2.3, [`super::levels`]); with the level of detail, the two passes compute
+//!   only what the frame's lookups read;
 //! - `probe_grid`: where moving meshes are, the irradiance of the grid's spatial receivers
 //!   around them (4.1; the basis pass computes their clusters' vectors too);
 //! - `probe_gather`: the lightmap at the uv of each pixel's triangle (the G-buffer numbers
@@ -27,19 +30,20 @@ use gpu_allocator::MemoryLocation;
 
 use super::file::BakeData;
 use super::grid::Grid;
+use super::levels::{LightmapLevels, Work, LEVELS};
 use super::sh::Basis;
 use super::{octahedral, BakeReport, BakeSettings, Origin};
 use crate::gi::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
     Switch, Technique,
 };
-use crate::gpu_layout::{self as layout, ProbeUniforms, RayHit, RAY_NONE};
+use crate::gpu_layout::{self as layout, ProbeUniforms, ProbeView, RayHit, RAY_NONE};
 use crate::ray::surfaces::{texel_buffer, SceneTriangles};
 use crate::scene::Scene;
 use crate::vk::{
     clear_to_zero, compute_to_compute, groups_2d, sampler_info, stage_barrier, update_buffer,
-    Binding, Buffer, Context, DescriptorSets, Image, ImageDesc, ImageUse, OneShot, Pipeline,
-    Sampler, SetWriter, TexelBuffer,
+    Binding, Buffer, Context, DescriptorSets, Image, ImageDesc, ImageUse, OneShot, OwnedView,
+    Pipeline, Sampler, SetWriter, TexelBuffer,
 };
 
 /// The technique's settings: the bake's, and where its file is.
@@ -160,11 +164,11 @@ impl LevelsOfDetail {
     }
 
     /// This frame's `BINDING_PROBE_LOD` for a camera at `camera` (`on`: else everything
-    /// at level 0), and the probes at each level. A cluster's level is that of its receivers' box's nearest point (4.2.2); a
-    /// probe takes the finest level of the clusters it supports, so that every basis
-    /// vector finds the coefficients it reads (the thesis shifts the probes' distance by
-    /// their radius to the same end, 4.2.1).
-    fn entries(&self, camera: glam::Vec3, on: bool) -> (Vec<u32>, [u32; 4]) {
+    /// at level 0), the probes at each level, and each cluster's level. A cluster's level is
+    /// that of its receivers' box's nearest point (4.2.2); a probe takes the finest level of
+    /// the clusters it supports, so that every basis vector finds the coefficients it reads
+    /// (the thesis shifts the probes' distance by their radius to the same end, 4.2.1).
+    fn entries(&self, camera: glam::Vec3, on: bool) -> (Vec<u32>, [u32; 4], Vec<u8>) {
         let level_at = |d: f32| {
             if on {
                 self.distances.iter().filter(|&&l| d >= l).count()
@@ -174,6 +178,7 @@ impl LevelsOfDetail {
         };
         let mut probe_level = vec![LOD_BANDS.len() - 1; self.probes];
         let mut clusters = Vec::with_capacity(self.bounds.len());
+        let mut cluster_levels = Vec::with_capacity(self.bounds.len());
         for (bounds, probes) in self.bounds.iter().zip(&self.cluster_probes) {
             let nearest = camera.clamp(bounds.min, bounds.max);
             let level = level_at(camera.distance(nearest));
@@ -182,6 +187,7 @@ impl LevelsOfDetail {
                 probe_level[p] = probe_level[p].min(level);
             }
             clusters.push(self.coefficients(level));
+            cluster_levels.push(level as u8);
         }
         if !on {
             probe_level.fill(0);
@@ -195,7 +201,7 @@ impl LevelsOfDetail {
             })
             .collect();
         entries.extend(clusters);
-        (entries, per_level)
+        (entries, per_level, cluster_levels)
     }
 }
 
@@ -538,8 +544,19 @@ pub struct ProbeGi {
     uniforms: Buffer,
     lambda: Buffer,
     basis: Buffer,
-    /// Written by alternate frames.
+    /// Per lightmap, a view of each of its levels (dropped before the lightmaps).
+    _level_views: Vec<OwnedView>,
+    /// Written by alternate frames, with their coarser levels.
     lightmaps: [Image; 2],
+    /// Which texels of which levels stand for which receivers, and what the last recorded
+    /// frame computed (its clusters' levels, its lists, and the buffer that holds them).
+    levels: LightmapLevels,
+    cluster_levels: Vec<u8>,
+    work: Work,
+    work_buffer: Buffer,
+    /// `ProbeView` as the last frame had it.
+    view_buffer: Buffer,
+    view: ProbeView,
     /// The grid of spatial receivers' irradiance, and this frame's list of its work.
     grid: Image,
     grid_active: Buffer,
@@ -562,6 +579,7 @@ pub struct ProbeGi {
     relight: Pipeline,
     basis_pass: Pipeline,
     receivers: Pipeline,
+    levels_pass: Pipeline,
     grid_pass: Pipeline,
     gather: Pipeline,
     counts: ProbeUniforms,
@@ -679,22 +697,51 @@ impl ProbeGi {
             bytemuck::bytes_of(&counts),
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
+        if width.max(height) < 1 << (LEVELS - 1) {
+            bail!(
+                "the bake's lightmap is {width} × {height} texels: its {LEVELS} levels need \
+                 {} texels along one side at least; bake with a larger --lightmap-size",
+                1 << (LEVELS - 1)
+            );
+        }
         let lightmap = |i: usize| {
             Image::new(
                 ctx,
                 &format!("probe lightmap {i}"),
-                ImageDesc::d2(
-                    LIGHTMAP_FORMAT,
-                    width,
-                    height,
-                    vk::ImageUsageFlags::STORAGE
-                        | vk::ImageUsageFlags::SAMPLED
-                        | vk::ImageUsageFlags::TRANSFER_DST
-                        | vk::ImageUsageFlags::TRANSFER_SRC,
-                ),
+                ImageDesc {
+                    mip_levels: LEVELS as u32,
+                    ..ImageDesc::d2(
+                        LIGHTMAP_FORMAT,
+                        width,
+                        height,
+                        vk::ImageUsageFlags::STORAGE
+                            | vk::ImageUsageFlags::SAMPLED
+                            | vk::ImageUsageFlags::TRANSFER_DST
+                            | vk::ImageUsageFlags::TRANSFER_SRC,
+                    )
+                },
             )
         };
         let lightmaps = [lightmap(0)?, lightmap(1)?];
+        let mut level_views = Vec::with_capacity(2 * LEVELS);
+        for image in &lightmaps {
+            for level in 0..LEVELS as u32 {
+                level_views.push(image.layer_view(0, level)?);
+            }
+        }
+        let levels = LightmapLevels::new(
+            data.lightmap,
+            &data.receiver_texels,
+            &data.receiver_clusters,
+        );
+        // The counts, then at most every receiver and every texel of the coarser levels.
+        let work_buffer = Buffer::new(
+            ctx,
+            "probe work",
+            4 * (2 + u64::from(counts.receiver_count) + 2 * levels.texel_count() as u64),
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuOnly,
+        )?;
         let [gx, gy, gz, points] = counts.grid_size;
         let limit = ctx.properties.limits.max_image_dimension3_d;
         if gx.max(gy).max(6 * gz) > limit {
@@ -757,7 +804,18 @@ impl ProbeGi {
             probe_list: data.cluster_probes.clone(),
         };
         // Level 0 until a frame finds other levels for its camera.
-        let (entries, probes_per_level) = lod.entries(glam::Vec3::ZERO, false);
+        let (entries, probes_per_level, _) = lod.entries(glam::Vec3::ZERO, false);
+        let view = ProbeView {
+            camera: [0.0; 4],
+            previous_camera: [0.0; 4],
+            distances: [lod.distances[0], lod.distances[1], lod.distances[2], 0.0],
+        };
+        let view_buffer = Buffer::with_data(
+            ctx,
+            "probe view",
+            bytemuck::bytes_of(&view),
+            vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+        )?;
         let lod_buffer = Buffer::with_data(
             ctx,
             "probe lod",
@@ -844,6 +902,22 @@ impl ProbeGi {
                 vk::DescriptorType::STORAGE_BUFFER,
                 compute,
             ),
+            Binding::new(
+                layout::BINDING_PROBE_LIGHTMAP_LEVELS,
+                vk::DescriptorType::STORAGE_IMAGE,
+                compute,
+            )
+            .array(LEVELS as u32 - 1),
+            Binding::new(
+                layout::BINDING_PROBE_WORK,
+                vk::DescriptorType::STORAGE_BUFFER,
+                compute,
+            ),
+            Binding::new(
+                layout::BINDING_PROBE_VIEW,
+                vk::DescriptorType::UNIFORM_BUFFER,
+                compute,
+            ),
         ]);
         let descriptor_sets = DescriptorSets::new(ctx, "probes", &bindings, 2)?;
         let sets = [
@@ -868,6 +942,12 @@ impl ProbeGi {
                     grid_active.raw,
                 )
                 .buffer(layout::BINDING_PROBE_LOD, storage_buffer, lod_buffer.raw)
+                .buffer(layout::BINDING_PROBE_WORK, storage_buffer, work_buffer.raw)
+                .buffer(
+                    layout::BINDING_PROBE_VIEW,
+                    vk::DescriptorType::UNIFORM_BUFFER,
+                    view_buffer.raw,
+                )
                 .storage_image(layout::BINDING_PROBE_GRID, grid.view)
                 .sampled_image(
                     layout::BINDING_PROBE_GRID_SAMPLED,
@@ -897,7 +977,19 @@ impl ProbeGi {
                     layout::BINDING_PROBE_TEXEL_CLUSTERS,
                     t.texel_clusters.view(),
                 )
-                .storage_image(layout::BINDING_PROBE_LIGHTMAP, lightmaps[i].view)
+                .storage_image(layout::BINDING_PROBE_LIGHTMAP, level_views[i * LEVELS].raw)
+                .images(
+                    layout::BINDING_PROBE_LIGHTMAP_LEVELS,
+                    vk::DescriptorType::STORAGE_IMAGE,
+                    level_views[i * LEVELS + 1..(i + 1) * LEVELS]
+                        .iter()
+                        .map(|v| vk::DescriptorImageInfo {
+                            sampler: vk::Sampler::null(),
+                            image_view: v.raw,
+                            image_layout: vk::ImageLayout::GENERAL,
+                        })
+                        .collect(),
+                )
                 .sampled_image(
                     layout::BINDING_PROBE_LIGHTMAP_SAMPLED,
                     lightmaps[i].view,
@@ -922,6 +1014,7 @@ impl ProbeGi {
         let relight = pipeline("probe_relight", s::GI_PROBES_RELIGHT_COMP, &coefficients)?;
         let basis_pass = pipeline("probe_basis", s::GI_PROBES_BASIS_COMP, &coefficients)?;
         let receivers = pipeline("probe_receivers", s::GI_PROBES_RECEIVERS_COMP, &[])?;
+        let levels_pass = pipeline("probe_levels", s::GI_PROBES_LEVELS_COMP, &[])?;
         let grid_pass = pipeline("probe_grid", s::GI_PROBES_GRID_COMP, &[])?;
         let gather = pipeline("probe_gather", s::GI_PROBES_GATHER_COMP, &[])?;
         let decode = pipeline("probe_surfaces", s::GI_PROBES_SURFACES_COMP, &[])?;
@@ -958,7 +1051,15 @@ impl ProbeGi {
             uniforms,
             lambda,
             basis,
+            _level_views: level_views,
             lightmaps,
+            levels,
+            // Differs from any frame's, so that the first frame lists its work.
+            cluster_levels: Vec::new(),
+            work: Work::default(),
+            work_buffer,
+            view_buffer,
+            view,
             grid,
             grid_active,
             grid_tables: tables.grid,
@@ -974,6 +1075,7 @@ impl ProbeGi {
             relight,
             basis_pass,
             receivers,
+            levels_pass,
             grid_pass,
             gather,
             counts,
@@ -1048,12 +1150,40 @@ impl Technique for ProbeGi {
             update_buffer(ctx, cmd, buffer, 0, bytemuck::cast_slice(list), readers);
         };
         let camera = glam::Vec4::from(frame.uniforms.camera_position).truncate();
-        let (entries, per_level) = self.lod.entries(camera, self.lod_on);
+        let (entries, per_level, cluster_levels) = self.lod.entries(camera, self.lod_on);
         if entries != self.lod_entries {
             upload(self.lod_buffer.raw, &entries);
             self.lod_entries = entries;
         }
         self.probes_per_level = per_level;
+        if cluster_levels != self.cluster_levels {
+            self.work = self.levels.work(&cluster_levels);
+            self.cluster_levels = cluster_levels;
+            let mut list = vec![
+                self.work.receivers.len() as u32,
+                self.work.texels.len() as u32,
+            ];
+            list.extend(&self.work.receivers);
+            list.extend(self.work.texels.iter().flatten());
+            upload(self.work_buffer.raw, &list);
+        }
+        // The first frame after a restart has no earlier lightmap but its own iterations'.
+        let now = camera.extend(f32::from(u8::from(self.lod_on))).to_array();
+        let view = ProbeView {
+            previous_camera: if self.iterations > 1 {
+                now
+            } else {
+                self.view.camera
+            },
+            camera: now,
+            ..self.view
+        };
+        if view != self.view {
+            let bytes = bytemuck::bytes_of(&view);
+            let readers = vk::PipelineStageFlags2::COMPUTE_SHADER;
+            update_buffer(ctx, cmd, self.view_buffer.raw, 0, bytes, readers);
+            self.view = view;
+        }
         // The grid's work where moving meshes are this frame; none without them.
         let (mut listed_vectors, mut listed_receivers) = (0, 0);
         let scene = frame.draw.scene;
@@ -1082,8 +1212,17 @@ impl Technique for ProbeGi {
             timer.end(cmd);
             compute_to_compute(ctx, cmd);
             timer.begin(cmd, "probe_receivers");
-            let groups = c.receiver_count.div_ceil(layout::PROBE_GROUP_SIZE);
-            self.receivers.dispatch(cmd, &sets, [groups, 1, 1]);
+            let groups = (self.work.receivers.len() as u32).div_ceil(layout::PROBE_GROUP_SIZE);
+            if groups > 0 {
+                self.receivers.dispatch(cmd, &sets, [groups, 1, 1]);
+            }
+            timer.end(cmd);
+            compute_to_compute(ctx, cmd);
+            timer.begin(cmd, "probe_levels");
+            let groups = (self.work.texels.len() as u32).div_ceil(layout::PROBE_GROUP_SIZE);
+            if groups > 0 {
+                self.levels_pass.dispatch(cmd, &sets, [groups, 1, 1]);
+            }
             timer.end(cmd);
             compute_to_compute(ctx, cmd);
             self.next = 1 - self.next;
@@ -1160,7 +1299,10 @@ impl Technique for ProbeGi {
             "probe_grid",
             self.grid.memory_bytes() + self.grid_active.size,
         ));
-        bytes.push(("probe_lod", self.lod_buffer.size));
+        bytes.push((
+            "probe_lod",
+            self.lod_buffer.size + self.work_buffer.size + self.view_buffer.size,
+        ));
         bytes
     }
 
@@ -1193,6 +1335,8 @@ impl Technique for ProbeGi {
             ("lod_probes_1".into(), f64::from(self.probes_per_level[1])),
             ("lod_probes_2".into(), f64::from(self.probes_per_level[2])),
             ("lod_probes_3".into(), f64::from(self.probes_per_level[3])),
+            ("lod_receivers".into(), self.work.receivers.len() as f64),
+            ("lod_level_texels".into(), self.work.texels.len() as f64),
         ])
     }
 

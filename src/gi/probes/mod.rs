@@ -16,6 +16,7 @@ pub mod clusters;
 pub mod file;
 pub mod frame;
 pub mod grid;
+pub mod levels;
 pub mod lightmap;
 pub mod octahedral;
 pub mod placement;

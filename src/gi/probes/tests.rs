@@ -587,14 +587,25 @@ fn render_probes(
     (ctx, renderer)
 }
 
-/// The RGB of each texel of the probes' half-float `image` (a lightmap or the grid), row
-/// by row (slice by slice).
-fn read_rgb(ctx: &std::sync::Arc<crate::vk::Context>, image: &crate::vk::Image) -> Vec<Vec3> {
+/// The RGB of each texel of mip `level` of the probes' half-float `image` (a lightmap or
+/// the grid), row by row (slice by slice).
+fn read_rgb(
+    ctx: &std::sync::Arc<crate::vk::Context>,
+    image: &crate::vk::Image,
+    level: usize,
+) -> Vec<Vec3> {
+    let e = image.desc.extent;
+    let (width, height) = super::levels::mip_size(e.width, e.height, level);
+    let extent = ash::vk::Extent3D {
+        width,
+        height,
+        depth: e.depth,
+    };
     let bytes = crate::vk::read_back_image(
         ctx,
         image,
-        0,
-        image.desc.extent,
+        level as u32,
+        extent,
         8,
         super::frame::LIGHTMAP_USE,
     )
@@ -631,6 +642,46 @@ fn reconstructed(data: &super::file::BakeData, lambda: &[Vec3], sky: Vec3, r: us
     e
 }
 
+/// The host twin tests' settings: a small bake into `dir`, one bounce, and the level of
+/// detail with levels from `lod_distances` (`None`: off).
+fn twin_settings(dir: &TempDir, lod_distances: Option<[f32; 3]>) -> super::frame::ProbeSettings {
+    super::frame::ProbeSettings {
+        bake: super::BakeSettings {
+            lightmap_size: 64,
+            probes: 32,
+            overlaps: 8,
+            probe_side: 32,
+            receiver_rays: 32,
+            sh_order: 3,
+            ..super::BakeSettings::default()
+        },
+        bake_file: Some(dir.0.join("box.bake")),
+        bounces: 1,
+        lod: lod_distances.is_some(),
+        lod_distances,
+    }
+}
+
+/// The bake `settings` made of `scene`, and its probes' λ as the host computes them
+/// from the emission and the sky their rays meet.
+fn host_lambda(
+    scene: &Scene,
+    settings: &super::frame::ProbeSettings,
+) -> (super::file::BakeData, Vec<Vec3>) {
+    let key = super::file::content_key(scene, &settings.bake);
+    let data = super::file::BakeData::read(settings.bake_file.as_ref().unwrap(), key).unwrap();
+    let statics = super::static_scene(scene);
+    let triangles = crate::ray::Triangles::of(&statics, 0.0, |_| true);
+    let views = super::casting::ProbeViews {
+        side: data.probe_side as usize,
+        hits: data.probe_hits.clone(),
+    };
+    let basis = super::sh::Basis::new(data.sh_order);
+    let lambda =
+        super::relight::emitted_lambda(&statics, &triangles, &views, data.probes.len(), &basis);
+    (data, lambda)
+}
+
 /// The glowing box with no lights under a coloured sky, rendered with `--gi probes` and
 /// no bounces: the lightmap the GPU's relight, projection, basis and receivers passes
 /// write holds every receiver's irradiance / π as the host computes it from the same
@@ -640,7 +691,7 @@ fn reconstructed(data: &super::file::BakeData, lambda: &[Vec3], sky: Vec3, r: us
 /// of the points around it, and nothing (its clear) everywhere else.
 #[test]
 fn the_frames_lightmap_and_grid_match_the_host_twin() {
-    use super::frame::{ProbeGi, ProbeSettings};
+    use super::frame::ProbeGi;
     let dir = TempDir::new("probe_frame_twin");
     let mut scene = glowing_cornell(&dir);
     scene.lights.clear();
@@ -656,37 +707,12 @@ fn the_frames_lightmap_and_grid_match_the_host_twin() {
     });
     scene.triangle_count += moving.indices.len() / 3;
     scene.meshes.push(moving);
-    let bake_file = dir.0.join("box.bake");
-    let settings = ProbeSettings {
-        bake: super::BakeSettings {
-            lightmap_size: 64,
-            probes: 32,
-            overlaps: 8,
-            probe_side: 32,
-            receiver_rays: 32,
-            sh_order: 3,
-            ..super::BakeSettings::default()
-        },
-        bake_file: Some(bake_file.clone()),
-        bounces: 1,
-        lod: false,
-        lod_distances: None,
-    };
+    let settings = twin_settings(&dir, None);
     let (ctx, renderer) = render_probes(&scene, &settings);
     let probes: &ProbeGi = renderer.gi_as().unwrap();
     let w = probes.lightmap_size()[0];
-    let lightmap = read_rgb(&ctx, probes.lightmap());
-    let key = super::file::content_key(&scene, &settings.bake);
-    let data = super::file::BakeData::read(&bake_file, key).unwrap();
-    let statics = super::static_scene(&scene);
-    let triangles = crate::ray::Triangles::of(&statics, 0.0, |_| true);
-    let views = super::casting::ProbeViews {
-        side: data.probe_side as usize,
-        hits: data.probe_hits.clone(),
-    };
-    let basis = super::sh::Basis::new(data.sh_order);
-    let lambda =
-        super::relight::emitted_lambda(&statics, &triangles, &views, data.probes.len(), &basis);
+    let lightmap = read_rgb(&ctx, probes.lightmap(), 0);
+    let (data, lambda) = host_lambda(&scene, &settings);
     let (mut worst, mut total) = (0.0f32, 0.0f32);
     for r in 0..data.receiver_texels.len() {
         let expected = reconstructed(&data, &lambda, scene.sky, r) / std::f32::consts::PI;
@@ -707,7 +733,7 @@ fn the_frames_lightmap_and_grid_match_the_host_twin() {
         "a receiver's texel is {:.2} % off the host's",
         100.0 * worst
     );
-    let values = read_rgb(&ctx, probes.grid());
+    let values = read_rgb(&ctx, probes.grid(), 0);
     let [min, max] = data.grid_bounds.map(Vec3::from);
     let grid = super::grid::Grid {
         size: glam::UVec3::from_array(data.grid_size),
@@ -752,12 +778,142 @@ fn the_frames_lightmap_and_grid_match_the_host_twin() {
     assert!(zero, "the grid was computed away from the moving mesh");
 }
 
+/// The lightmap's levels (Sedláček 2019, 4.2.3) with the level of detail on, in the
+/// glowing box of the host twin's test (one frame, one bounce, every receiver's irradiance
+/// above zero) with levels 1 to 3 beginning 3.6, 4.2 and 4.8 from the camera: every texel
+/// that a lookup from a surface can read at its cluster's level or coarser (the 3 × 3
+/// texels around the surface's own at each such level) was written this frame (the
+/// lightmap starts cleared to zero) with the irradiance its receiver's own texel holds,
+/// and the receivers of clusters at level 0 (all bands, all rays) hold the host twin's,
+/// though the frame computes only part of the receivers. (Farther clusters read fewer
+/// bands of probes relit from fewer rays: the twin, with all of them, is no reference
+/// there.)
+#[test]
+fn the_lightmaps_levels_hold_what_lookups_read() {
+    use super::frame::ProbeGi;
+    use super::levels::{mip_size, LightmapLevels, LEVELS};
+    use crate::gi::Technique;
+    let dir = TempDir::new("probe_levels");
+    let mut scene = glowing_cornell(&dir);
+    scene.lights.clear();
+    scene.sky = Vec3::new(0.2, 0.4, 0.8);
+    let distances = [3.6f32, 4.2, 4.8];
+    let settings = twin_settings(&dir, Some(distances));
+    let (ctx, renderer) = render_probes(&scene, &settings);
+    let probes: &ProbeGi = renderer.gi_as().unwrap();
+    let mips: Vec<Vec<Vec3>> = (0..LEVELS)
+        .map(|k| read_rgb(&ctx, probes.lightmap(), k))
+        .collect();
+    let stats = probes.stats().unwrap();
+    let stat = |name: &str| stats.iter().find(|(k, _)| k == name).unwrap().1;
+    let (data, lambda) = host_lambda(&scene, &settings);
+    let receivers = data.receiver_texels.len();
+    let expected: Vec<Vec3> = (0..receivers)
+        .map(|r| reconstructed(&data, &lambda, scene.sky, r) / std::f32::consts::PI)
+        .collect();
+    let levels = LightmapLevels::new(
+        data.lightmap,
+        &data.receiver_texels,
+        &data.receiver_clusters,
+    );
+    let [width, height] = data.lightmap;
+    let camera = scene.camera.position;
+    let cluster_level = |r: usize| {
+        let [min, max] = data.cluster_bounds[data.receiver_clusters[r] as usize];
+        let nearest = camera.clamp(Vec3::from(min), Vec3::from(max));
+        distances
+            .iter()
+            .filter(|&&d| camera.distance(nearest) >= d)
+            .count()
+    };
+    let (mut worst, mut checked, mut per_level) = (0.0f32, [0usize; LEVELS], [0usize; LEVELS]);
+    let (mut unwritten, mut miscopied) = (Vec::new(), Vec::new());
+    for k in 0..LEVELS {
+        let (w, h) = mip_size(width, height, k);
+        // Each texel of this level and the receiver whose irradiance it holds.
+        let held: std::collections::HashMap<[u32; 2], u32> = if k == 0 {
+            (0..receivers as u32)
+                .map(|r| (data.receiver_texels[r as usize], r))
+                .collect()
+        } else {
+            levels.texels(k).collect()
+        };
+        let mut read = std::collections::HashSet::new();
+        for r in (0..receivers).filter(|&r| cluster_level(r) <= k) {
+            per_level[k] += 1;
+            let [x, y] = data.receiver_texels[r];
+            // The texel of this level that holds the receiver's texel's centre.
+            let (x, y) = (
+                i64::from((2 * x + 1) * w / (2 * width)),
+                i64::from((2 * y + 1) * h / (2 * height)),
+            );
+            for (dx, dy) in (-1..=1).flat_map(|dx| (-1..=1).map(move |dy| (dx, dy))) {
+                let (tx, ty) = (x + dx, y + dy);
+                if tx >= 0 && ty >= 0 && tx < i64::from(w) && ty < i64::from(h) {
+                    read.insert([tx as u32, ty as u32]);
+                }
+            }
+        }
+        for t in read {
+            if let Some(&r) = held.get(&t) {
+                let got = mips[k][(t[1] * w + t[0]) as usize];
+                let [x, y] = data.receiver_texels[r as usize];
+                let own = mips[0][(y * width + x) as usize];
+                if got == Vec3::ZERO {
+                    unwritten.push((k, t));
+                } else if got != own {
+                    miscopied.push((k, t, got, own));
+                }
+                if cluster_level(r as usize) == 0 {
+                    let want = expected[r as usize];
+                    let error = (got - want).abs().max_element() / want.max_element().max(1e-3);
+                    worst = worst.max(error);
+                }
+                checked[k] += 1;
+            }
+        }
+    }
+    let computed = stat("lod_receivers");
+    eprintln!(
+        "receivers at their cluster's level or finer, per level {per_level:?}; texels checked \
+         {checked:?}, worst relative difference {worst:.4}; {computed} of {receivers} receivers \
+         computed"
+    );
+    assert!(
+        per_level[0] > 0 && per_level[0] < receivers,
+        "the levels {per_level:?} do not split the box"
+    );
+    assert!(
+        unwritten.is_empty(),
+        "{} texels a lookup reads were not written this frame: {:?}",
+        unwritten.len(),
+        &unwritten[..unwritten.len().min(8)]
+    );
+    assert!(
+        miscopied.is_empty(),
+        "{} texels differ from their receiver's: {:?}",
+        miscopied.len(),
+        &miscopied[..miscopied.len().min(8)]
+    );
+    assert!(
+        worst < 0.005,
+        "a texel a lookup reads is {:.2} % off the host's",
+        100.0 * worst
+    );
+    assert!(
+        computed < receivers as f64,
+        "{computed} of {receivers} receivers computed"
+    );
+}
+
 /// The dynamic level of detail (Sedláček 2019, 4.2) against `--probe-lod off`, on the
 /// built-in box lit by its point light through 8 bounces, with levels 1 to 3 beginning
-/// 3.6, 4.2 and 4.8 from the camera (the box spans 2.9 to 5.2): the lightmap of the
-/// receivers whose cluster is at level 0 (the part near the camera) agrees within 1 %
-/// (their probes' relight is the same; only the bounces from farther receivers differ),
-/// and each farther level's error is reported.
+/// 3.6, 4.2 and 4.8 from the camera (the box spans 2.9 to 5.2), a 128² lightmap: at each
+/// receiver, the texel of its cluster's level that holds it against the same receiver's
+/// texel with the level of detail off. Near the camera (level 0) they agree within
+/// 1.5 %: the probes' relight there is the same, and only the bounces from farther
+/// surfaces differ, read from coarser texels (1.2 % here, 2.2 % with a 64² lightmap:
+/// the error falls with the texel's size). Each farther level's error is reported.
 #[test]
 fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
     use super::frame::{ProbeGi, ProbeSettings};
@@ -766,7 +922,7 @@ fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
     let scene = cornell();
     let distances = [3.6f32, 4.2, 4.8];
     let bake = super::BakeSettings {
-        lightmap_size: 64,
+        lightmap_size: 128,
         probes: 64,
         probe_side: 32,
         receiver_rays: 32,
@@ -784,13 +940,12 @@ fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
         let (ctx, renderer) = render_probes(&scene, &settings);
         let probes: &ProbeGi = renderer.gi_as().unwrap();
         let stats = probes.stats().unwrap();
-        (
-            read_rgb(&ctx, probes.lightmap()),
-            probes.lightmap_size()[0],
-            stats,
-        )
+        let mips: Vec<Vec<Vec3>> = (0..super::levels::LEVELS)
+            .map(|k| read_rgb(&ctx, probes.lightmap(), k))
+            .collect();
+        (mips, probes.lightmap_size(), stats)
     };
-    let (on, width, stats) = lightmap(true);
+    let (on, [width, height], stats) = lightmap(true);
     let (off, _, _) = lightmap(false);
     let levels: Vec<_> = stats
         .iter()
@@ -802,6 +957,15 @@ fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
     )
     .unwrap();
     let camera = scene.camera.position;
+    let levels_of = super::levels::LightmapLevels::new(
+        data.lightmap,
+        &data.receiver_texels,
+        &data.receiver_clusters,
+    );
+    // Per level, each texel's receiver.
+    let held: Vec<std::collections::HashMap<[u32; 2], u32>> = (1..super::levels::LEVELS)
+        .map(|k| levels_of.texels(k).collect())
+        .collect();
     let (mut sum, mut count) = ([0.0f64; 4], [0usize; 4]);
     for (r, &[x, y]) in data.receiver_texels.iter().enumerate() {
         let [min, max] = data.cluster_bounds[data.receiver_clusters[r] as usize];
@@ -810,9 +974,23 @@ fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
             .iter()
             .filter(|&&d| camera.distance(nearest) >= d)
             .count();
-        let texel = (y * width + x) as usize;
-        let reference = off[texel].max_element().max(1e-3);
-        sum[level] += f64::from((on[texel] - off[texel]).abs().max_element() / reference);
+        let (got, standing_for) = if level == 0 {
+            (on[0][(y * width + x) as usize], [x, y])
+        } else {
+            let (w, h) = super::levels::mip_size(width, height, level);
+            let t = [
+                (2 * x + 1) * w / (2 * width),
+                (2 * y + 1) * h / (2 * height),
+            ];
+            let s = held[level - 1][&t] as usize;
+            (
+                on[level][(t[1] * w + t[0]) as usize],
+                data.receiver_texels[s],
+            )
+        };
+        let reference = off[0][(standing_for[1] * width + standing_for[0]) as usize];
+        sum[level] +=
+            f64::from((got - reference).abs().max_element() / reference.max_element().max(1e-3));
         count[level] += 1;
     }
     let mean: Vec<f64> = (0..4).map(|l| sum[l] / count[l].max(1) as f64).collect();
@@ -822,7 +1000,7 @@ fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
         "the levels {count:?} do not split the box"
     );
     assert!(
-        mean[0] <= 0.01,
+        mean[0] <= 0.015,
         "the receivers near the camera are {:.2} % off",
         100.0 * mean[0]
     );
