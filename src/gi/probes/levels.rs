@@ -278,26 +278,18 @@ mod tests {
             }
             // A block with receivers holds the one nearest its centre.
             for ([tx, ty], r) in levels.texels(k) {
-                let inside: Vec<_> = texels
+                // Squared distance from a texel's centre to the block's, in level-0 texels.
+                let c = |t: u32| (f64::from(t) + 0.5) * f64::from(1u32 << k);
+                let d = |[x, y]: [u32; 2]| {
+                    (f64::from(x) + 0.5 - c(tx)).powi(2) + (f64::from(y) + 0.5 - c(ty)).powi(2)
+                };
+                let nearest = texels
                     .iter()
                     .filter(|&&[x, y]| [x >> k, y >> k] == [tx, ty])
-                    .collect();
-                if let Some(nearest) = inside.iter().min_by(|a, b| {
-                    let d = |&&&[x, y]: &&&[u32; 2]| {
-                        let c = |t: u32| (f64::from(t) + 0.5) * f64::from(1u32 << k);
-                        (f64::from(x) + 0.5 - c(tx)).powi(2) + (f64::from(y) + 0.5 - c(ty)).powi(2)
-                    };
-                    d(a).partial_cmp(&d(b)).unwrap()
-                }) {
-                    let d = |[x, y]: [u32; 2]| {
-                        let c = |t: u32| (f64::from(t) + 0.5) * f64::from(1u32 << k);
-                        (f64::from(x) + 0.5 - c(tx)).powi(2) + (f64::from(y) + 0.5 - c(ty)).powi(2)
-                    };
-                    assert_eq!(
-                        d(texels[r as usize]),
-                        d(**nearest),
-                        "level {k} at {tx}, {ty}"
-                    );
+                    .map(|&t| d(t))
+                    .min_by(|a, b| a.partial_cmp(b).unwrap());
+                if let Some(nearest) = nearest {
+                    assert_eq!(d(texels[r as usize]), nearest, "level {k} at {tx}, {ty}");
                 }
             }
         }
