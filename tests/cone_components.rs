@@ -8,6 +8,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{flat_plane, probe_furnace, render, render_256, render_path, shared, temp_dir, write};
+use voxcone::compare::{compare, CompareOptions};
 use voxcone::imageio::load_rgb;
 
 /// Mean over the channels of the centre 8x8 pixels.
@@ -395,4 +396,81 @@ fn cone_component_is_the_cone_integral() {
             "cone {k}: {traced} against {exact}"
         );
     }
+}
+
+/// The first bounce's total over the conference view (the image less its direct light,
+/// ours with `--bounces 1`, the path tracer's with `--max-depth 3` less `--max-depth 2`)
+/// at 64³ and at 256³: each within 5 % of the path tracer's. Cluttered rooms lose light
+/// as the voxels get finer where the Cornell box barely does (measured 0.982 at 256³).
+#[test]
+#[cfg_attr(
+    voxcone_shared,
+    ignore = "issue 20: 1.026 of the path tracer's at 64³, 0.869 at 256³"
+)]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn first_bounce_holds_its_total_as_the_voxels_get_finer() {
+    let scene = shared().join("reference/conference_main.scene.json");
+    let dir = temp_dir("components_conference_bounce");
+    let path = |f: &str| dir.join(f);
+    let traced = |depth: &str, out: &Path| {
+        render_path(
+            &scene,
+            &["--size", "256x256", "--spp", "64", "--max-depth", depth],
+            out,
+        );
+    };
+    traced("2", &path("path_direct.exr"));
+    traced("3", &path("path_one.exr"));
+    render_256(&scene, &["--gi", "off"], &path("off.exr"));
+    let total = |v: Vec<f64>| v.iter().sum::<f64>();
+    let exact = total(block_indirect(
+        &path("path_one.exr"),
+        &path("path_direct.exr"),
+    ));
+    let mut ratios = Vec::new();
+    for voxels in [64, 256] {
+        let out = path(&format!("one_{voxels}.exr"));
+        dense(&scene, voxels, &["--bounces", "1"], &out);
+        ratios.push(total(block_indirect(&out, &path("off.exr"))) / exact);
+    }
+    eprintln!("first bounce over the path tracer's, 64³ and 256³: {ratios:.3?}");
+    for r in ratios {
+        assert!((r - 1.0).abs() <= 0.05, "{r}");
+    }
+}
+
+/// Convergence: LDR-FLIP against each reference at 128³ is no higher than at 64³ (within
+/// 0.003), `--gi dense` at default settings but the resolution.
+#[test]
+#[cfg_attr(
+    voxcone_shared,
+    ignore = "issue 20: cornell_point 0.0994 → 0.1044, cornell_area 0.1901 → 0.1925, conference_main 0.2007 → 0.2292"
+)]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn flip_does_not_rise_as_the_voxels_get_finer() {
+    let dir = temp_dir("components_convergence");
+    let mut rising = Vec::new();
+    for name in [
+        "cornell_point",
+        "cornell_area",
+        "sponza_main",
+        "sibenik_main",
+        "conference_main",
+    ] {
+        let reference = shared().join(format!("reference/{name}.exr"));
+        let scene = shared().join(format!("reference/{name}.scene.json"));
+        let flip = |voxels: u32| {
+            let out = dir.join(format!("{name}_{voxels}.exr"));
+            dense(&scene, voxels, &[], &out);
+            compare(&reference, &out, &CompareOptions::default())
+                .unwrap()
+                .flip_ldr
+        };
+        let (coarse, fine) = (flip(64), flip(128));
+        eprintln!("{name}: LDR-FLIP {coarse:.4} at 64³, {fine:.4} at 128³");
+        if fine > coarse + 0.003 {
+            rising.push((name, coarse, fine));
+        }
+    }
+    assert!(rising.is_empty(), "rises: {rising:?}");
 }
