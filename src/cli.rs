@@ -145,7 +145,8 @@ pub struct CommonArgs {
     /// cone along the normal, 1 to --diffuse-cones - 1 the ring's. --gi dense and --gi
     /// octree trace that cone alone for the indirect light (albedo times its radiance);
     /// --gi path shows albedo times the exact mean radiance within it (one bounce with
-    /// --max-depth 3), instead of the image.
+    /// --max-depth 3), instead of the image, for the layout that --diffuse-cones and
+    /// --diffuse-aperture give.
     #[arg(long)]
     pub cone: Option<u32>,
 }
@@ -390,7 +391,16 @@ impl CommonArgs {
             bail!("--cone is a cone of the cone tracer's gather: it needs --gi dense, --gi octree or --gi path");
         }
         if !matches!(self.gi, GiMode::Dense | GiMode::Octree) {
-            if let Some(option) = self.vct.given().first() {
+            // The path tracer's cone component takes the gather's layout, so that the
+            // exact cones of any layout can be rendered.
+            let layout = ["--diffuse-cones", "--diffuse-aperture"];
+            let path_cone = self.gi == GiMode::Path && self.cone.is_some();
+            if let Some(option) = self
+                .vct
+                .given()
+                .into_iter()
+                .find(|o| !(path_cone && layout.contains(o)))
+            {
                 bail!("{option} works on the voxels: it needs --gi dense or --gi octree");
             }
         }
@@ -618,6 +628,49 @@ mod tests {
             "4",
         ]));
         assert_eq!((gi.voxels, gi.cones.diffuse_cones), (16, 4));
+    }
+
+    /// The path tracer's cone component takes the gather's layout from the command line;
+    /// without `--cone` the layout's options are still the voxels' alone.
+    #[test]
+    fn path_cone_takes_the_gathers_layout() {
+        let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
+            Some(Command::Render(r)) => r.common.render_settings(&GiOverrides::default()),
+            _ => unreachable!(),
+        };
+        let settings = parse(&[
+            "voxcone",
+            "render",
+            "--gi",
+            "path",
+            "--cone",
+            "7",
+            "--diffuse-cones",
+            "9",
+            "--diffuse-aperture",
+            "40",
+        ])
+        .unwrap();
+        let cone = match settings.gi {
+            GiSettings::Path(path) => path.cone.unwrap(),
+            _ => panic!("no path tracer"),
+        };
+        assert_eq!((cone.index, cone.ring, cone.aperture_deg), (7, 8, 40.0));
+        let err =
+            parse(&["voxcone", "render", "--gi", "path", "--diffuse-cones", "9"]).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("--diffuse-cones works on the voxels"),
+            "{err}"
+        );
+        let err = parse(&[
+            "voxcone", "render", "--gi", "path", "--cone", "1", "--voxels", "32",
+        ])
+        .unwrap_err();
+        assert!(
+            err.to_string().contains("--voxels works on the voxels"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -474,3 +474,180 @@ fn flip_does_not_rise_as_the_voxels_get_finer() {
     }
     assert!(rising.is_empty(), "rises: {rising:?}");
 }
+
+/// A white receiver (0.3 square at the origin, facing +y) and a square emitter (side 1,
+/// radiance 1, facing the receiver) 3.5 away in the direction `theta` from the normal and
+/// `phi` round it from the first ring cone's azimuth (-z), as a scene file in `dir`. Two
+/// black specks at ±8 set the grid, so that the emitter lies far inside it (the grid's
+/// face reads differently: session 23). A narrow camera above the receiver shows what it
+/// gathers in its centre pixels.
+fn emitter_around_receiver(dir: &Path, theta: f64, phi: f64) -> PathBuf {
+    use glam::DVec3;
+    let (theta, phi) = (theta.to_radians(), phi.to_radians());
+    let d = theta.cos() * DVec3::Y
+        + theta.sin() * (phi.cos() * DVec3::NEG_Z + phi.sin() * DVec3::NEG_X);
+    let (u, v) = d.any_orthonormal_pair();
+    let mut corners: Vec<DVec3> = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+        .iter()
+        .map(|&(a, b)| 3.5 * d + 0.5 * (a * u + b * v))
+        .collect();
+    // Wound so that the emitting face looks at the receiver.
+    if (corners[1] - corners[0])
+        .cross(corners[2] - corners[0])
+        .dot(d)
+        > 0.0
+    {
+        corners.reverse();
+    }
+    let mut obj = String::from("mtllib a.mtl\n");
+    for c in &corners {
+        obj += &format!("v {} {} {}\n", c.x, c.y, c.z);
+    }
+    obj += "v -0.15 0 0.15\nv 0.15 0 0.15\nv 0.15 0 -0.15\nv -0.15 0 -0.15\n\
+            v -8 -8 -8\nv -7.99 -8 -8\nv -8 -7.99 -8\nv 8 8 8\nv 7.99 8 8\nv 8 7.99 8\n\
+            usemtl emit\nf 1 2 3 4\nusemtl receiver\nf 5 6 7 8\nusemtl black\nf 9 10 11\nf 12 13 14\n";
+    write(
+        dir,
+        "a.mtl",
+        "newmtl emit\nKd 0 0 0\nKe 1 1 1\nnewmtl receiver\nKd 1 1 1\nnewmtl black\nKd 0 0 0\n",
+    );
+    write(dir, "a.obj", &obj);
+    write(
+        dir,
+        "a.toml",
+        "[camera]\nposition = [0, 1, 0.01]\ntarget = [0, 0, 0]\nfov_y_deg = 6\n[[mesh]]\npath = \"a.obj\"\n",
+    )
+}
+
+/// What the receiver gathers from the emitter at (`theta`, `phi`) with one bounce at
+/// `voxels`³, over the path tracer's direct light from it (the same integral).
+fn small_emitter_response(dir: &Path, theta: f64, phi: f64, voxels: u32) -> f32 {
+    let scene = emitter_around_receiver(dir, theta, phi);
+    let (ours, path) = (dir.join("ours.exr"), dir.join("path.exr"));
+    let voxels = voxels.to_string();
+    render(
+        &scene,
+        &[
+            "--gi",
+            "dense",
+            "--voxels",
+            &voxels,
+            "--bounces",
+            "1",
+            "--size",
+            "32x32",
+        ],
+        &ours,
+    );
+    render_path(
+        &scene,
+        &["--size", "32x32", "--spp", "64", "--max-depth", "2"],
+        &path,
+    );
+    centre(&ours) / centre(&path)
+}
+
+/// The gather is a quadrature of the cosine-weighted hemisphere: a small emitter (16
+/// degrees across) contributes the cosine's share whatever its direction, within 15 %,
+/// at 256³ (where it covers 20 voxels, so that its voxelization barely changes its size).
+/// Directions from the normal to 80 degrees, on a ring cone's azimuth and half-way to the
+/// next one.
+#[test]
+#[ignore = "issue 20: 0.414 (45°, between the normal's cone and a ring cone) to 1.533 (80°, under a ring cone)"]
+fn small_emitter_is_gathered_in_the_cosines_share_from_every_direction() {
+    let dir = temp_dir("components_small_emitter_directions");
+    let mut off = Vec::new();
+    for theta in [0.0, 30.0, 45.0, 57.5, 70.0, 80.0] {
+        for phi in [0.0, 36.0] {
+            let r = small_emitter_response(&dir, theta, phi, 256);
+            eprintln!("small emitter at {theta}°, azimuth {phi}°: {r:.3} of the path tracer's");
+            if (r - 1.0).abs() > 0.15 {
+                off.push((theta, phi, r));
+            }
+        }
+    }
+    assert!(off.is_empty(), "off by more than 15 %: {off:?}");
+}
+
+/// The same emitter straight above: at 64³ (4 voxels across) it gives what it gives at
+/// 256³, within 10 %. The tracer's kernel has the same shape at every resolution, so a
+/// difference is the emitter's voxelization: a conservative one widens it by up to a
+/// voxel.
+#[test]
+#[ignore = "issue 20: 0.675 at 64³ against 0.587 at 256³ (1.15 times)"]
+fn small_emitter_keeps_its_share_as_the_voxels_get_coarser() {
+    let dir = temp_dir("components_small_emitter_resolution");
+    let coarse = small_emitter_response(&dir, 0.0, 0.0, 64);
+    let fine = small_emitter_response(&dir, 0.0, 0.0, 256);
+    eprintln!("small emitter above: {coarse:.3} at 64³, {fine:.3} at 256³ of the path tracer's");
+    assert!(
+        (coarse / fine - 1.0).abs() <= 0.1,
+        "{coarse} against {fine}"
+    );
+}
+
+/// The cone set itself, with every cone exact: the path tracer's cone components (`--cone
+/// K`, the mean radiance in each cone times the albedo) weighted as the gather weighs
+/// them (1 for the normal's cone, 0.5 for each of the five in the ring, over 3.5) give the
+/// path tracer's one bounce per 32x32 block of the Cornell view within 10 %. Where they do
+/// not, no tracer of these cones can: the layout is then what limits
+/// `one_bounce_per_block_matches_the_path_tracer`.
+#[test]
+#[cfg_attr(
+    voxcone_shared,
+    ignore = "issue 20: 54 of the 64 blocks within 10 %, from 0.89 to 1.39 (total 0.968)"
+)]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn exact_cones_weighted_as_the_gather_give_the_first_bounce_per_block() {
+    let shared = shared();
+    let scene = shared.join("reference/cornell_point.scene.json");
+    let dir = temp_dir("components_exact_cones");
+    let direct = shared.join("reference/cornell_point_direct.exr");
+    render_path(
+        &scene,
+        &["--size", "256x256", "--spp", "512", "--max-depth", "3"],
+        &dir.join("one.exr"),
+    );
+    let one = block_indirect(&dir.join("one.exr"), &direct);
+    let mut cones = vec![0.0; one.len()];
+    for k in 0..6 {
+        let out = dir.join(format!("cone{k}.exr"));
+        let image = render_path(
+            &scene,
+            &[
+                "--size",
+                "256x256",
+                "--spp",
+                "128",
+                "--max-depth",
+                "3",
+                "--cone",
+                &k.to_string(),
+            ],
+            &out,
+        );
+        let weight = if k == 0 { 1.0 / 3.5 } else { 0.5 / 3.5 };
+        let w = image.width as usize;
+        for (i, p) in image.data.chunks(3).enumerate() {
+            let (x, y) = (i % w, i / w);
+            cones[(y / 32) * (w / 32) + x / 32] += weight * f64::from(p.iter().sum::<f32>());
+        }
+    }
+    let brightest = one.iter().cloned().fold(0.0, f64::max);
+    let total = |v: &[f64]| v.iter().sum::<f64>();
+    let mut outside = Vec::new();
+    for (i, (c, o)) in cones.iter().zip(&one).enumerate() {
+        if *o > 0.02 * brightest && (c / o - 1.0).abs() > 0.1 {
+            outside.push((i, c / o));
+        }
+    }
+    eprintln!(
+        "exact cones over the one bounce: total {:.3}; blocks off by more than 10 %: {outside:?}",
+        total(&cones) / total(&one)
+    );
+    assert!(
+        outside.is_empty(),
+        "{} blocks off: {outside:?}",
+        outside.len()
+    );
+}
