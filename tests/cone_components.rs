@@ -587,11 +587,11 @@ fn small_emitter_keeps_its_share_as_the_voxels_get_coarser() {
 }
 
 /// The cone set itself, with every cone exact: the path tracer's cone components (`--cone
-/// K`, the mean radiance in each cone times the albedo) weighted as the gather weighs
-/// them (1 for the normal's cone, 0.5 for each of the five in the ring, over 3.5) give the
+/// K`, the mean radiance in each cone times the albedo) weighted as the gather weighs them
+/// (1 for the normal's cone, 0.5 for each of the five in the ring, over 3.5) give the
 /// path tracer's one bounce per 32x32 block of the Cornell view within 10 %. Where they do
-/// not, no tracer of these cones can: the layout is then what limits
-/// `one_bounce_per_block_matches_the_path_tracer`.
+/// not, a tracer whose cones read exactly these discs cannot pass
+/// `one_bounce_per_block_matches_the_path_tracer` either.
 #[test]
 #[cfg_attr(
     voxcone_shared,
