@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use common::{flat_plane, probe_furnace, render, render_256, render_path, shared, temp_dir, write};
 use voxcone::compare::{compare, CompareOptions};
-use voxcone::imageio::load_rgb;
+use voxcone::imageio::{load_rgb, RgbImage};
 
 /// Mean over the channels of the centre 8x8 pixels.
 fn centre(path: &Path) -> f32 {
@@ -166,18 +166,34 @@ fn thin_wall_passes_little_light() {
     assert!(fine < coarse, "128³ passes {fine}, 64³ {coarse}");
 }
 
-/// The indirect light (the image less its direct light) summed over 32x32 blocks.
-fn block_indirect(image: &Path, direct: &Path) -> Vec<f64> {
-    let (image, _) = load_rgb(image).unwrap();
-    let (direct, _) = load_rgb(direct).unwrap();
+/// An image's channels summed over 32x32 blocks.
+fn block_sums(image: &RgbImage) -> Vec<f64> {
     let w = image.width as usize;
     let mut blocks = vec![0.0; (w / 32) * (image.height as usize / 32)];
-    for (i, (a, b)) in image.data.chunks(3).zip(direct.data.chunks(3)).enumerate() {
+    for (i, p) in image.data.chunks(3).enumerate() {
         let (x, y) = (i % w, i / w);
-        let indirect: f32 = a.iter().zip(b).map(|(a, b)| a - b).sum();
-        blocks[(y / 32) * (w / 32) + x / 32] += f64::from(indirect);
+        blocks[(y / 32) * (w / 32) + x / 32] += f64::from(p.iter().sum::<f32>());
     }
     blocks
+}
+
+/// The indirect light (the image less its direct light) summed over 32x32 blocks.
+fn block_indirect(image: &Path, direct: &Path) -> Vec<f64> {
+    let image = block_sums(&load_rgb(image).unwrap().0);
+    let direct = block_sums(&load_rgb(direct).unwrap().0);
+    image.iter().zip(direct).map(|(a, b)| a - b).collect()
+}
+
+/// The blocks (index, ratio) where `ours` is off `reference` by more than 10 %, among
+/// those whose reference is above 2 % of the brightest block's.
+fn blocks_off(ours: &[f64], reference: &[f64]) -> Vec<(usize, f64)> {
+    let brightest = reference.iter().cloned().fold(0.0, f64::max);
+    ours.iter()
+        .zip(reference)
+        .enumerate()
+        .filter(|(_, (o, r))| **r > 0.02 * brightest && (*o / *r - 1.0).abs() > 0.1)
+        .map(|(i, (o, r))| (i, o / r))
+        .collect()
 }
 
 /// The Cornell box (point light) with one bounce, ours (`--bounces 1`: the voxels hold
@@ -227,13 +243,7 @@ fn cornell_bounces(name: &str, spp: u32) -> CornellBounces {
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn one_bounce_per_block_matches_the_path_tracer() {
     let b = cornell_bounces("components_one_bounce", 512);
-    let brightest = b.path_one.iter().cloned().fold(0.0, f64::max);
-    let mut outside = Vec::new();
-    for (i, (ours, path)) in b.ours_one.iter().zip(&b.path_one).enumerate() {
-        if *path > 0.02 * brightest && (ours / path - 1.0).abs() > 0.1 {
-            outside.push((i, ours / path));
-        }
-    }
+    let outside = blocks_off(&b.ours_one, &b.path_one);
     eprintln!("one bounce: blocks off by more than 10 %: {outside:?}");
     assert!(
         outside.is_empty(),
@@ -627,20 +637,12 @@ fn exact_cones_weighted_as_the_gather_give_the_first_bounce_per_block() {
             &out,
         );
         let weight = if k == 0 { 1.0 / 3.5 } else { 0.5 / 3.5 };
-        let w = image.width as usize;
-        for (i, p) in image.data.chunks(3).enumerate() {
-            let (x, y) = (i % w, i / w);
-            cones[(y / 32) * (w / 32) + x / 32] += weight * f64::from(p.iter().sum::<f32>());
+        for (sum, block) in cones.iter_mut().zip(block_sums(&image)) {
+            *sum += weight * block;
         }
     }
-    let brightest = one.iter().cloned().fold(0.0, f64::max);
     let total = |v: &[f64]| v.iter().sum::<f64>();
-    let mut outside = Vec::new();
-    for (i, (c, o)) in cones.iter().zip(&one).enumerate() {
-        if *o > 0.02 * brightest && (c / o - 1.0).abs() > 0.1 {
-            outside.push((i, c / o));
-        }
-    }
+    let outside = blocks_off(&cones, &one);
     eprintln!(
         "exact cones over the one bounce: total {:.3}; blocks off by more than 10 %: {outside:?}",
         total(&cones) / total(&one)
