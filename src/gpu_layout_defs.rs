@@ -864,6 +864,10 @@ gpu_layout! {
         vec4 camera,
         /// The last frame's, the same way.
         vec4 previous_camera,
+        /// This frame's view direction (xyz, unit) and the cosine of the half-angle of the cone around it that holds the view frustum (w): the level of detail's zones.
+        vec4 forward,
+        /// The last frame's, the same way.
+        vec4 previous_forward,
         /// The distances where the lightmap's levels 1, 2 and 3 begin (xyz).
         vec4 distances,
     }

@@ -12,27 +12,8 @@ use super::{SceneRays, Triangles};
 use crate::gpu_layout::{RayHit, RayQuery, RAY_ANY, RAY_CLOSEST, RAY_NONE};
 use crate::scene::testing::{shared_file, TempDir};
 use crate::scene::{LoadOptions, Scene};
-use crate::testing::validating_context;
+use crate::testing::{validating_context, Random};
 use crate::vk::Context;
-
-/// A small deterministic generator (xorshift), so that the rays are the same every run.
-struct Random(u64);
-
-impl Random {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    fn direction(&mut self) -> Vec3 {
-        let z = 2.0 * self.next() - 1.0;
-        let phi = std::f32::consts::TAU * self.next();
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        Vec3::new(r * phi.cos(), r * phi.sin(), z)
-    }
-}
 
 /// The scene's triangles as the CPU twin tests them, with their cut-out coverage.
 struct Twin<'a> {

@@ -104,7 +104,7 @@ void main() {
         vec2 bary = barycentrics(ray_triangle(i), p);
         vec2 at = lightmap_uv(i, bary);
         if (at.x >= 0.0) {
-            float level = lightmap_level(p, view.camera);
+            float level = lightmap_level(p, view.camera, view.forward);
             e = textureLod(lightmap, at, level).rgb;
             ivec2 size = textureSize(lightmap, 0);
             ivec2 texel = clamp(ivec2(at * vec2(size)), ivec2(0), size - 1);

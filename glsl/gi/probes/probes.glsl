@@ -13,18 +13,31 @@ layout(set = SET_GI, binding = BINDING_PROBE_VIEW) uniform ViewBlock {
     ProbeView view;
 };
 
+// How much farther than it is a point counts for the level of detail, by the zone around
+// the camera it lies in (Sedláček 2019, 4.2.1, Figure 4.8), from the cosine of its angle
+// to the view direction and that of the cone holding the view frustum: 1 inside that
+// cone, 2 beside it in front of the camera, 4 behind. Surfaces out of view reach the
+// image only through the probes' bounces, so they take coarser levels sooner.
+// `LevelsOfDetail::entries` (frame.rs) gives the clusters the same zones.
+float zone_scale(float cos_angle, float cos_frustum) {
+    return cos_angle >= cos_frustum ? 1.0 : (cos_angle >= 0.0 ? 2.0 : 4.0);
+}
+
 // The lightmap level a lookup at `p` reads for a camera at `camera` (xyz; w: the level of
-// detail is on), fractional (Sedláček 2019, 4.2.4): level k from distance k on, blended
-// in from the finer level over the last quarter of the span before it. The clusters'
-// levels (`frame.rs`) step at the same distances, and a surface is no nearer the camera
-// than its cluster's box, so a lookup never reads a level finer than its cluster computed:
-// the blend only ever reaches towards the coarser level (the thesis's smoothing), and it
-// ends where the coarser level begins (its shifted distance for fragments).
-float lightmap_level(vec3 p, vec4 camera) {
+// detail is on) looking along `forward` (xyz; w: the frustum's cone), fractional (Sedláček
+// 2019, 4.2.4): level k from distance k on (scaled by the point's zone), blended in from
+// the finer level over the last quarter of the span before it. The clusters' levels
+// (`frame.rs`) step at the same distances, and a surface is no nearer the camera than its
+// cluster's box, nor in a nearer zone than the nearest part of the box, so a lookup never
+// reads a level finer than its cluster computed: the blend only ever reaches towards the
+// coarser level (the thesis's smoothing), and it ends where the coarser level begins (its
+// shifted distance for fragments).
+float lightmap_level(vec3 p, vec4 camera, vec4 forward) {
     if (camera.w == 0.0) {
         return 0.0;
     }
     float d = distance(p, camera.xyz);
+    d *= d > 0.0 ? zone_scale(dot(p - camera.xyz, forward.xyz) / d, forward.w) : 1.0;
     float level = 0.0;
     float start = 0.0;
     for (int k = 0; k < 3; k++) {

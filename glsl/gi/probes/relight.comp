@@ -61,7 +61,8 @@ vec3 radiance_along(uint ray) {
     }
     vec3 radiance = albedo / PI * irradiance + vec3(unpackHalf2x16(b.z), unpackHalf2x16(b.w).x);
     if (probes.bounces != 0u && b.y != NO_LIGHTMAP_UV) {
-        float level = max(lightmap_level(p, view.camera), lightmap_level(p, view.previous_camera));
+        float level = max(lightmap_level(p, view.camera, view.forward),
+                            lightmap_level(p, view.previous_camera, view.previous_forward));
         radiance += albedo * textureLod(previous_lightmap, unpackUnorm2x16(b.y), level).rgb;
     }
     return radiance;

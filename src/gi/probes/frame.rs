@@ -37,7 +37,9 @@ use crate::gi::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
     Switch, Technique,
 };
-use crate::gpu_layout::{self as layout, ProbeUniforms, ProbeView, RayHit, RAY_NONE};
+use crate::gpu_layout::{
+    self as layout, FrameUniforms, ProbeUniforms, ProbeView, RayHit, RAY_NONE,
+};
 use crate::ray::surfaces::{texel_buffer, SceneTriangles};
 use crate::scene::Scene;
 use crate::vk::{
@@ -145,7 +147,106 @@ const LOD_RAY_STRIDE: [u32; 4] = [1, 2, 4, 4];
 /// LDR-FLIP goes from 0.070 to 0.079; from 16 the box is all level 0.
 pub const LOD_RADII: [f32; 3] = [16.0, 32.0, 64.0];
 
-/// The level of detail of each frame, from the camera's position.
+/// The camera as the level of detail sees it: where it is, where it looks, and the cosine
+/// of the half-angle of the cone around its view direction that holds its frustum.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LodCamera {
+    pub position: glam::Vec3,
+    pub forward: glam::Vec3,
+    pub cos_frustum: f32,
+}
+
+impl LodCamera {
+    /// The camera of a frame's uniforms (a perspective projection).
+    pub fn new(uniforms: &FrameUniforms) -> Self {
+        Self::from_matrices(
+            glam::Vec4::from(uniforms.camera_position).truncate(),
+            glam::Mat4::from_cols_array_2d(&uniforms.view),
+            glam::Mat4::from_cols_array_2d(&uniforms.proj),
+        )
+    }
+
+    /// The camera at `position` with the world-to-view `view` and the perspective `proj`.
+    pub fn from_matrices(position: glam::Vec3, view: glam::Mat4, proj: glam::Mat4) -> Self {
+        // The frustum's corner rays make the widest angle with the view direction.
+        let corner = glam::Vec2::new(1.0 / proj.x_axis.x, 1.0 / proj.y_axis.y);
+        Self {
+            position,
+            forward: view
+                .inverse()
+                .transform_vector3(glam::Vec3::NEG_Z)
+                .normalize(),
+            cos_frustum: 1.0 / (1.0 + corner.length_squared()).sqrt(),
+        }
+    }
+
+    /// The level of the box `bounds` for levels beginning at `distances`: that of its
+    /// nearest point, its distance scaled by the box's zone.
+    pub fn box_level(&self, bounds: &crate::scene::Aabb, distances: &[f32; 3]) -> usize {
+        let nearest = self.position.clamp(bounds.min, bounds.max);
+        level_at(
+            self.position.distance(nearest) * self.box_scale(bounds),
+            distances,
+        )
+    }
+
+    /// The whole level a lookup at `p` reads at least (the shaders' `lightmap_level` is
+    /// this or up to one more where it blends towards the next).
+    #[cfg(test)]
+    pub fn point_level(&self, p: glam::Vec3, distances: &[f32; 3]) -> usize {
+        let to = p - self.position;
+        let d = to.length();
+        let scale = if d > 0.0 {
+            zone_scale(to.dot(self.forward) / d, self.cos_frustum)
+        } else {
+            1.0
+        };
+        level_at(d * scale, distances)
+    }
+
+    /// `ProbeView`'s `forward`.
+    fn forward(&self) -> [f32; 4] {
+        self.forward.extend(self.cos_frustum).to_array()
+    }
+
+    /// How much farther than it is the box `bounds` counts: the zone (`zone_scale`) of its
+    /// bounding sphere's part nearest the view direction, so that no point of the box lies
+    /// in a zone nearer than the box's.
+    fn box_scale(&self, bounds: &crate::scene::Aabb) -> f32 {
+        let centre = 0.5 * (bounds.min + bounds.max);
+        let radius = 0.5 * bounds.min.distance(bounds.max);
+        let to = centre - self.position;
+        let d = to.length();
+        if d <= radius {
+            return 1.0;
+        }
+        let angle = (to.dot(self.forward) / d).clamp(-1.0, 1.0).acos();
+        let nearest = (angle - (radius / d).asin()).max(0.0);
+        zone_scale(nearest.cos(), self.cos_frustum)
+    }
+}
+
+/// The level at distance `d` for levels beginning at `distances`.
+fn level_at(d: f32, distances: &[f32; 3]) -> usize {
+    distances.iter().filter(|&&l| d >= l).count()
+}
+
+/// How much farther than it is a point counts for the level of detail, by the zone around
+/// the camera it lies in (Sedláček 2019, 4.2.1, Figure 4.8): 1 inside the cone holding
+/// the view frustum, 2 beside it in front of the camera, 4 behind. Surfaces out of view
+/// reach the image only through the probes' bounces, so they take coarser levels sooner.
+/// The shaders' `zone_scale` (`glsl/gi/probes/probes.glsl`) is the same.
+fn zone_scale(cos_angle: f32, cos_frustum: f32) -> f32 {
+    if cos_angle >= cos_frustum {
+        1.0
+    } else if cos_angle >= 0.0 {
+        2.0
+    } else {
+        4.0
+    }
+}
+
+/// The level of detail of each frame, from the camera.
 struct LevelsOfDetail {
     /// Where levels 1 to 3 begin.
     distances: [f32; 3],
@@ -163,25 +264,22 @@ impl LevelsOfDetail {
         (LOD_BANDS[level].min(self.order) + 1).pow(2)
     }
 
-    /// This frame's `BINDING_PROBE_LOD` for a camera at `camera` (`on`: else everything
-    /// at level 0), the probes at each level, and each cluster's level. A cluster's level is
-    /// that of its receivers' box's nearest point (4.2.2); a probe takes the finest level of
-    /// the clusters it supports, so that every basis vector finds the coefficients it reads
-    /// (the thesis shifts the probes' distance by their radius to the same end, 4.2.1).
-    fn entries(&self, camera: glam::Vec3, on: bool) -> (Vec<u32>, [u32; 4], Vec<u8>) {
-        let level_at = |d: f32| {
-            if on {
-                self.distances.iter().filter(|&&l| d >= l).count()
-            } else {
-                0
-            }
-        };
+    /// This frame's `BINDING_PROBE_LOD` for `camera` (`on`: else everything at level 0),
+    /// the probes at each level, and each cluster's level. A cluster's level is that of its
+    /// receivers' box's nearest point (4.2.2), its distance scaled by the box's zone; a
+    /// probe takes the finest level of the clusters it supports, so that every basis
+    /// vector finds the coefficients it reads (the thesis shifts the probes' distance by
+    /// their radius to the same end, 4.2.1).
+    fn entries(&self, camera: &LodCamera, on: bool) -> (Vec<u32>, [u32; 4], Vec<u8>) {
         let mut probe_level = vec![LOD_BANDS.len() - 1; self.probes];
         let mut clusters = Vec::with_capacity(self.bounds.len());
         let mut cluster_levels = Vec::with_capacity(self.bounds.len());
         for (bounds, probes) in self.bounds.iter().zip(&self.cluster_probes) {
-            let nearest = camera.clamp(bounds.min, bounds.max);
-            let level = level_at(camera.distance(nearest));
+            let level = if on {
+                camera.box_level(bounds, &self.distances)
+            } else {
+                0
+            };
             for &p in &self.probe_list[probes.clone()] {
                 let p = p as usize;
                 probe_level[p] = probe_level[p].min(level);
@@ -804,10 +902,17 @@ impl ProbeGi {
             probe_list: data.cluster_probes.clone(),
         };
         // Level 0 until a frame finds other levels for its camera.
-        let (entries, probes_per_level, _) = lod.entries(glam::Vec3::ZERO, false);
+        let off = LodCamera {
+            position: glam::Vec3::ZERO,
+            forward: glam::Vec3::NEG_Z,
+            cos_frustum: 0.0,
+        };
+        let (entries, probes_per_level, _) = lod.entries(&off, false);
         let view = ProbeView {
             camera: [0.0; 4],
             previous_camera: [0.0; 4],
+            forward: off.forward(),
+            previous_forward: off.forward(),
             distances: [lod.distances[0], lod.distances[1], lod.distances[2], 0.0],
         };
         let view_buffer = Buffer::with_data(
@@ -1149,8 +1254,8 @@ impl Technique for ProbeGi {
             let readers = vk::PipelineStageFlags2::COMPUTE_SHADER;
             update_buffer(ctx, cmd, buffer, 0, bytemuck::cast_slice(list), readers);
         };
-        let camera = glam::Vec4::from(frame.uniforms.camera_position).truncate();
-        let (entries, per_level, cluster_levels) = self.lod.entries(camera, self.lod_on);
+        let camera = LodCamera::new(frame.uniforms);
+        let (entries, per_level, cluster_levels) = self.lod.entries(&camera, self.lod_on);
         if entries != self.lod_entries {
             upload(self.lod_buffer.raw, &entries);
             self.lod_entries = entries;
@@ -1168,14 +1273,20 @@ impl Technique for ProbeGi {
             upload(self.work_buffer.raw, &list);
         }
         // The first frame after a restart has no earlier lightmap but its own iterations'.
-        let now = camera.extend(f32::from(u8::from(self.lod_on))).to_array();
+        let now = camera
+            .position
+            .extend(f32::from(u8::from(self.lod_on)))
+            .to_array();
+        let restart = self.iterations > 1;
         let view = ProbeView {
-            previous_camera: if self.iterations > 1 {
-                now
+            previous_camera: if restart { now } else { self.view.camera },
+            previous_forward: if restart {
+                camera.forward()
             } else {
-                self.view.camera
+                self.view.forward
             },
             camera: now,
+            forward: camera.forward(),
             ..self.view
         };
         if view != self.view {

@@ -787,9 +787,22 @@ fn the_frames_lightmap_and_grid_match_the_host_twin() {
 /// and the receivers of clusters at level 0 (all bands, all rays) hold the host twin's,
 /// though the frame computes only part of the receivers. (Farther clusters read fewer
 /// bands of probes relit from fewer rays: the twin, with all of them, is no reference
-/// there.)
+/// there.) Once with the scene's camera, which sees the whole box, and once with it
+/// turned 45° to the left, where the box's right part lies beside the view and takes
+/// coarser levels sooner (the zones of 4.2.1).
 #[test]
 fn the_lightmaps_levels_hold_what_lookups_read() {
+    levels_hold_what_lookups_read(false);
+    levels_hold_what_lookups_read(true);
+}
+
+/// The camera the level of detail sees in a `render_probes` frame (64 × 64) of `scene`.
+fn lod_camera(scene: &Scene) -> super::frame::LodCamera {
+    let c = &scene.camera;
+    super::frame::LodCamera::from_matrices(c.position, c.view(), c.proj(1.0))
+}
+
+fn levels_hold_what_lookups_read(turned: bool) {
     use super::frame::ProbeGi;
     use super::levels::{mip_size, LightmapLevels, LEVELS};
     use crate::gi::Technique;
@@ -797,6 +810,12 @@ fn the_lightmaps_levels_hold_what_lookups_read() {
     let mut scene = glowing_cornell(&dir);
     scene.lights.clear();
     scene.sky = Vec3::new(0.2, 0.4, 0.8);
+    if turned {
+        let c = &mut scene.camera;
+        let forward = c.forward();
+        let left = -c.right();
+        c.target = c.position + (forward + left).normalize();
+    }
     let distances = [3.6f32, 4.2, 4.8];
     let settings = twin_settings(&dir, Some(distances));
     let (ctx, renderer) = render_probes(&scene, &settings);
@@ -817,15 +836,27 @@ fn the_lightmaps_levels_hold_what_lookups_read() {
         &data.receiver_clusters,
     );
     let [width, height] = data.lightmap;
-    let camera = scene.camera.position;
-    let cluster_level = |r: usize| {
+    let camera = lod_camera(&scene);
+    let bounds = |r: usize| {
         let [min, max] = data.cluster_bounds[data.receiver_clusters[r] as usize];
-        let nearest = camera.clamp(Vec3::from(min), Vec3::from(max));
-        distances
-            .iter()
-            .filter(|&&d| camera.distance(nearest) >= d)
-            .count()
+        crate::scene::Aabb {
+            min: Vec3::from(min),
+            max: Vec3::from(max),
+        }
     };
+    let cluster_level = |r: usize| camera.box_level(&bounds(r), &distances);
+    // How many receivers' clusters their zone makes coarser than their distance alone.
+    let coarser = (0..receivers)
+        .filter(|&r| {
+            let b = bounds(r);
+            let nearest = camera.position.clamp(b.min, b.max);
+            let by_distance = distances
+                .iter()
+                .filter(|&&d| camera.position.distance(nearest) >= d)
+                .count();
+            cluster_level(r) > by_distance
+        })
+        .count();
     let (mut worst, mut checked, mut per_level) = (0.0f32, [0usize; LEVELS], [0usize; LEVELS]);
     let (mut unwritten, mut miscopied) = (Vec::new(), Vec::new());
     for k in 0..LEVELS {
@@ -875,9 +906,14 @@ fn the_lightmaps_levels_hold_what_lookups_read() {
     }
     let computed = stat("lod_receivers");
     eprintln!(
-        "receivers at their cluster's level or finer, per level {per_level:?}; texels checked \
-         {checked:?}, worst relative difference {worst:.4}; {computed} of {receivers} receivers \
-         computed"
+        "camera turned: {turned}; receivers at their cluster's level or finer, per level \
+         {per_level:?}, {coarser} coarser by their zone; texels checked {checked:?}, worst \
+         relative difference {worst:.4}; {computed} of {receivers} receivers computed"
+    );
+    assert_eq!(
+        coarser > 0,
+        turned,
+        "{coarser} receivers' clusters coarser by their zone"
     );
     assert!(
         per_level[0] > 0 && per_level[0] < receivers,
@@ -956,7 +992,7 @@ fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
         super::file::content_key(&scene, &bake),
     )
     .unwrap();
-    let camera = scene.camera.position;
+    let camera = lod_camera(&scene);
     let levels_of = super::levels::LightmapLevels::new(
         data.lightmap,
         &data.receiver_texels,
@@ -969,11 +1005,11 @@ fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
     let (mut sum, mut count) = ([0.0f64; 4], [0usize; 4]);
     for (r, &[x, y]) in data.receiver_texels.iter().enumerate() {
         let [min, max] = data.cluster_bounds[data.receiver_clusters[r] as usize];
-        let nearest = camera.clamp(Vec3::from(min), Vec3::from(max));
-        let level = distances
-            .iter()
-            .filter(|&&d| camera.distance(nearest) >= d)
-            .count();
+        let bounds = crate::scene::Aabb {
+            min: Vec3::from(min),
+            max: Vec3::from(max),
+        };
+        let level = camera.box_level(&bounds, &distances);
         let (got, standing_for) = if level == 0 {
             (on[0][(y * width + x) as usize], [x, y])
         } else {
@@ -1070,4 +1106,75 @@ fn the_scenes_own_lightmap_uvs_are_kept_unless_they_overlap() {
     let receivers = super::place_receivers(&overlapping, &mut replaced, 128).unwrap();
     assert!(!replaced.authored, "overlapping UVs were kept");
     assert_eq!(receivers.overlaps, 0);
+}
+
+/// The level of detail's zones (Sedláček 2019, 4.2.1, Figure 4.8) never make a lookup read
+/// a level finer than its cluster computed: for cameras, boxes and points in the boxes
+/// drawn at random, the level a point reads (`LodCamera::point_level`, the shaders' rule)
+/// is at least its box's (`LodCamera::box_level`, the clusters'). And the zones scale as
+/// stated: a box in view keeps its distance's level, one behind the camera takes the level
+/// of four times its distance.
+#[test]
+fn a_lookup_reads_no_finer_level_than_its_cluster() {
+    use super::frame::LodCamera;
+    use crate::scene::Aabb;
+    let mut random = crate::testing::Random(0x2545_f491_4f6c_dd1d);
+    let distances = [1.0f32, 2.0, 4.0];
+    let mut zoned = 0;
+    for _ in 0..2000 {
+        let camera = LodCamera {
+            position: Vec3::new(random.next(), random.next(), random.next()) * 4.0 - 2.0,
+            forward: random.direction(),
+            cos_frustum: 0.5 + 0.45 * random.next(),
+        };
+        let centre = Vec3::new(random.next(), random.next(), random.next()) * 8.0 - 4.0;
+        let half = Vec3::new(random.next(), random.next(), random.next()) * 1.5;
+        let bounds = Aabb {
+            min: centre - half,
+            max: centre + half,
+        };
+        let level = camera.box_level(&bounds, &distances);
+        let nearest = camera.position.clamp(bounds.min, bounds.max);
+        let by_distance = distances
+            .iter()
+            .filter(|&&d| camera.position.distance(nearest) >= d)
+            .count();
+        assert!(level >= by_distance, "a zone made a box finer");
+        zoned += usize::from(level > by_distance);
+        for _ in 0..20 {
+            let p = bounds.min
+                + (bounds.max - bounds.min)
+                    * Vec3::new(random.next(), random.next(), random.next());
+            assert!(
+                camera.point_level(p, &distances) >= level,
+                "{camera:?}: a point of {bounds:?} reads level {} below its box's {level}",
+                camera.point_level(p, &distances)
+            );
+        }
+    }
+    assert!(
+        zoned > 100,
+        "only {zoned} of 2000 boxes coarser by their zone"
+    );
+    let camera = LodCamera {
+        position: Vec3::ZERO,
+        forward: Vec3::NEG_Z,
+        cos_frustum: 0.8,
+    };
+    let small = |at: Vec3| Aabb {
+        min: at - 0.01,
+        max: at + 0.01,
+    };
+    assert_eq!(
+        camera.box_level(&small(Vec3::new(0.0, 0.0, -1.5)), &distances),
+        1
+    );
+    assert_eq!(
+        camera.box_level(&small(Vec3::new(0.0, 0.0, 1.5)), &distances),
+        3
+    );
+    assert_eq!(
+        camera.box_level(&small(Vec3::new(1.5, 0.0, -0.2)), &distances),
+        2
+    );
 }
