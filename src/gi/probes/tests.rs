@@ -802,6 +802,26 @@ fn lod_camera(scene: &Scene) -> super::frame::LodCamera {
     super::frame::LodCamera::from_matrices(c.position, c.view(), c.proj(1.0))
 }
 
+/// The box of the receivers of `cluster`.
+fn cluster_box(data: &super::file::BakeData, cluster: u32) -> crate::scene::Aabb {
+    let [min, max] = data.cluster_bounds[cluster as usize];
+    crate::scene::Aabb {
+        min: Vec3::from(min),
+        max: Vec3::from(max),
+    }
+}
+
+/// The level of `bounds` by its distance from `camera` alone, without the zones.
+fn level_by_distance(
+    camera: &super::frame::LodCamera,
+    bounds: &crate::scene::Aabb,
+    distances: &[f32; 3],
+) -> usize {
+    let nearest = camera.position.clamp(bounds.min, bounds.max);
+    let d = camera.position.distance(nearest);
+    distances.iter().filter(|&&l| d >= l).count()
+}
+
 fn levels_hold_what_lookups_read(turned: bool) {
     use super::frame::ProbeGi;
     use super::levels::{mip_size, LightmapLevels, LEVELS};
@@ -837,25 +857,11 @@ fn levels_hold_what_lookups_read(turned: bool) {
     );
     let [width, height] = data.lightmap;
     let camera = lod_camera(&scene);
-    let bounds = |r: usize| {
-        let [min, max] = data.cluster_bounds[data.receiver_clusters[r] as usize];
-        crate::scene::Aabb {
-            min: Vec3::from(min),
-            max: Vec3::from(max),
-        }
-    };
+    let bounds = |r: usize| cluster_box(&data, data.receiver_clusters[r]);
     let cluster_level = |r: usize| camera.box_level(&bounds(r), &distances);
     // How many receivers' clusters their zone makes coarser than their distance alone.
     let coarser = (0..receivers)
-        .filter(|&r| {
-            let b = bounds(r);
-            let nearest = camera.position.clamp(b.min, b.max);
-            let by_distance = distances
-                .iter()
-                .filter(|&&d| camera.position.distance(nearest) >= d)
-                .count();
-            cluster_level(r) > by_distance
-        })
+        .filter(|&r| cluster_level(r) > level_by_distance(&camera, &bounds(r), &distances))
         .count();
     let (mut worst, mut checked, mut per_level) = (0.0f32, [0usize; LEVELS], [0usize; LEVELS]);
     let (mut unwritten, mut miscopied) = (Vec::new(), Vec::new());
@@ -1004,11 +1010,7 @@ fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
         .collect();
     let (mut sum, mut count) = ([0.0f64; 4], [0usize; 4]);
     for (r, &[x, y]) in data.receiver_texels.iter().enumerate() {
-        let [min, max] = data.cluster_bounds[data.receiver_clusters[r] as usize];
-        let bounds = crate::scene::Aabb {
-            min: Vec3::from(min),
-            max: Vec3::from(max),
-        };
+        let bounds = cluster_box(&data, data.receiver_clusters[r]);
         let level = camera.box_level(&bounds, &distances);
         let (got, standing_for) = if level == 0 {
             (on[0][(y * width + x) as usize], [x, y])
@@ -1134,11 +1136,7 @@ fn a_lookup_reads_no_finer_level_than_its_cluster() {
             max: centre + half,
         };
         let level = camera.box_level(&bounds, &distances);
-        let nearest = camera.position.clamp(bounds.min, bounds.max);
-        let by_distance = distances
-            .iter()
-            .filter(|&&d| camera.position.distance(nearest) >= d)
-            .count();
+        let by_distance = level_by_distance(&camera, &bounds, &distances);
         assert!(level >= by_distance, "a zone made a box finer");
         zoned += usize::from(level > by_distance);
         for _ in 0..20 {
