@@ -227,7 +227,7 @@ impl LodCamera {
 }
 
 /// The level at distance `d` for levels beginning at `distances`.
-fn level_at(d: f32, distances: &[f32; 3]) -> usize {
+pub(super) fn level_at(d: f32, distances: &[f32; 3]) -> usize {
     distances.iter().filter(|&&l| d >= l).count()
 }
 

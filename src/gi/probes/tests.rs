@@ -818,8 +818,7 @@ fn level_by_distance(
     distances: &[f32; 3],
 ) -> usize {
     let nearest = camera.position.clamp(bounds.min, bounds.max);
-    let d = camera.position.distance(nearest);
-    distances.iter().filter(|&&l| d >= l).count()
+    super::frame::level_at(camera.position.distance(nearest), distances)
 }
 
 fn levels_hold_what_lookups_read(turned: bool) {
