@@ -14,8 +14,11 @@
 // itself covers none; half stands between. A wall seen edge-on along one axis still
 // stops the cones that cross it: they see it face-on along another axis, and
 // sample_voxels adds up the optical depths. (With a weighted mean of the opacities
-// there, the half weight let light leak out of rooms.) Nothing edge-on at all (weight 0)
+// there, the half weight let light leave rooms.) Nothing edge-on at all (weight 0)
 // loses too much: Cornell box LDR-FLIP 0.27.
+// A two-sided voxel (its normal's alpha 0, where other voxels count their fragments: a
+// slab thinner than the voxel, both of whose faces it holds, inject.comp) blocks cones from either side and shows its light
+// only to those that look at its lit face: from behind it is the slab's unlit underside.
 vec4 facing(uint packed_normal, vec4 value, int d) {
     vec3 n = vec3(float(packed_normal & 0xffu), float((packed_normal >> 8) & 0xffu), float((packed_normal >> 16) & 0xffu)) / 127.5 - 1.0;
     if (length(n) < 0.2) {
@@ -23,7 +26,11 @@ vec4 facing(uint packed_normal, vec4 value, int d) {
     }
     vec3 towards_viewer = vec3(0.0);
     towards_viewer[d / 2] = (d % 2 == 0) ? -1.0 : 1.0;
-    float w = clamp(0.5 + 4.0 * dot(normalize(n), towards_viewer), 0.0, 1.0);
+    float c = dot(normalize(n), towards_viewer);
+    float w = clamp(0.5 + 4.0 * c, 0.0, 1.0);
+    if ((packed_normal >> 24) == 0u) {
+        return vec4(value.rgb * w, value.a * clamp(0.5 + 4.0 * abs(c), 0.0, 1.0));
+    }
     return value * w;
 }
 

@@ -89,19 +89,34 @@ fn mark(triangles: &[[Vec3; 3]], grid: &Grid, grow: f32) -> Vec<bool> {
     marked
 }
 
-/// Premultiplied RGBA `front` composited over `back`: what a ray sees passing through
-/// `front` first, then `back`.
-/// The weight `glsl/gi/vct/dense/filter.comp` gives a base voxel with (lit-side) normal `n`
-/// for cones travelling along `direction`: 1 facing the cone, 1/2 edge-on, 0 from behind.
-pub fn facing_weight(n: Vec3, direction: usize) -> f32 {
+/// What `glsl/gi/vct/anisotropic.glsl`'s `facing` shows of a base voxel of premultiplied
+/// radiance `value` with packed RGBA8 normal `packed` (turned to its lit side) to cones
+/// travelling along `direction`: all of it facing the cone, half edge-on, none from
+/// behind; a two-sided voxel (alpha 0) keeps its opacity from behind (half edge-on).
+pub fn seen_facing(packed: u32, value: [f32; 4], direction: usize) -> [f32; 4] {
+    let n = Vec3::new(
+        (packed & 0xff) as f32,
+        ((packed >> 8) & 0xff) as f32,
+        ((packed >> 16) & 0xff) as f32,
+    ) / 127.5
+        - 1.0;
     if n.length() < 0.2 {
-        return 1.0;
+        return value;
     }
     let mut towards_viewer = Vec3::ZERO;
     towards_viewer[direction / 2] = if direction % 2 == 0 { -1.0 } else { 1.0 };
-    (0.5 + 4.0 * n.normalize().dot(towards_viewer)).clamp(0.0, 1.0)
+    let c = n.normalize().dot(towards_viewer);
+    let w = (0.5 + 4.0 * c).clamp(0.0, 1.0);
+    let cover = if packed >> 24 == 0 {
+        (0.5 + 4.0 * c.abs()).clamp(0.0, 1.0)
+    } else {
+        w
+    };
+    [value[0] * w, value[1] * w, value[2] * w, value[3] * cover]
 }
 
+/// Premultiplied RGBA `front` composited over `back`: what a ray sees passing through
+/// `front` first, then `back`.
 pub fn over(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
     let transmittance = 1.0 - front[3];
     std::array::from_fn(|c| front[c] + transmittance * back[c])

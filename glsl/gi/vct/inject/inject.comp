@@ -53,6 +53,24 @@ float voxel_visibility(vec3 p, vec3 n, vec3 to_light, float dist) {
     return 1.0;
 }
 
+// The axis across a slab through voxel v: the axis whose plane through v holds the most
+// of v's 26 occupied neighbours, where one holds more than the other two (a one-voxel
+// rod, a solid block or a lone voxel have no such axis: zero).
+vec3 slab_axis(ivec3 v) {
+    ivec3 in_plane = ivec3(0);
+    for (int k = 0; k < 27; k++) {
+        ivec3 o = ivec3(k % 3, (k / 3) % 3, k / 9) - 1;
+        ivec3 u = v + o;
+        bool inside = all(greaterThanEqual(u, ivec3(0))) && all(lessThan(u, ivec3(vct.resolution)));
+        if (o != ivec3(0) && inside && voxel_occupied(u)) {
+            in_plane += ivec3(equal(o, ivec3(0)));
+        }
+    }
+    int most = max(in_plane.x, max(in_plane.y, in_plane.z));
+    ivec3 top = ivec3(equal(in_plane, ivec3(most)));
+    return top.x + top.y + top.z == 1 ? vec3(top) : vec3(0.0);
+}
+
 // Villegas' normal-weighted attenuation (2018, section 2.1): a voxel's averaged normal n
 // may point where none of its surfaces does (a floor meeting a wall averages to 45
 // degrees and would catch the light of both). Each axis face on n's side takes the
@@ -137,7 +155,23 @@ void main() {
     uint packed_normal = imageLoad(voxel_normal, voxel).r;
     vec3 n = unpack_normal(packed_normal);
     float len = length(n);
-    // Opposite normals averaged in one voxel cancel; such a voxel faces every way.
+    vec3 emission = unpack_rgba8(imageLoad(voxel_emission, voxel).r).rgb / 255.0 * vct.emission_range;
+    // Opposite normals averaged in one voxel cancel. Where the voxel lies in a slab (a
+    // table top thinner than the voxel, both of whose faces it holds), it takes the slab's
+    // axis and is marked two-sided (alpha 0), once: below, it keeps its lit face like any
+    // surface, and the filter shows that face's light only to cones that look at it, where
+    // a voxel facing every way showed the lit top to the floor under the table. Emitters
+    // keep facing every way (which face emits is lost in the mean).
+    if (len <= 0.2 && all(equal(emission, vec3(0.0)))) {
+        vec3 axis = slab_axis(entry.voxel);
+        if (axis != vec3(0.0)) {
+            packed_normal = pack_rgba8(vec4(axis * 127.5 + 127.5, 0.0));
+            imageStore(voxel_normal, voxel, uvec4(packed_normal));
+            n = unpack_normal(packed_normal);
+            len = length(n);
+        }
+    }
+    // Other voxels whose normals cancel face every way.
     n = len > 0.2 ? n / len : vec3(0.0, 1.0, 0.0);
     // Surfaces are two-sided: the voxel keeps the face that receives more light (emitters
     // their winding face), and its normal is turned to that face so that the filter
@@ -149,7 +183,6 @@ void main() {
         front += voxel_irradiance(lights[i], p, n);
         back += voxel_irradiance(lights[i], p, -n);
     }
-    vec3 emission = unpack_rgba8(imageLoad(voxel_emission, voxel).r).rgb / 255.0 * vct.emission_range;
     bool back_lit = dot(back, vec3(1.0)) > dot(front, vec3(1.0)) && all(equal(emission, vec3(0.0)));
     vec3 e = len > 0.2 ? (back_lit ? back : front) : front + back;
     if (len > 0.2 && back_lit) {

@@ -3,8 +3,6 @@
 
 use std::sync::Arc;
 
-use glam::Vec3;
-
 use super::super::reference;
 use super::super::voxelize::Voxelizer;
 use super::super::{Grid, Store};
@@ -118,18 +116,18 @@ fn filter_matches_cpu() {
     let (ctx, renderer) = render(Scene::load(&path, &options).unwrap(), n);
     let gi = dense(&renderer).store();
     let base = halves(&gi.download(Volume::Radiance, 0).unwrap());
-    let normals: Vec<Vec3> = gi
+    let normals: Vec<u32> = gi
         .download(Volume::Normal, 0)
         .unwrap()
         .chunks_exact(4)
-        .map(|t| Vec3::new(t[0] as f32, t[1] as f32, t[2] as f32) / 127.5 - 1.0)
+        .map(|t| u32::from_le_bytes([t[0], t[1], t[2], t[3]]))
         .collect();
     let mut worst = 0.0f32;
     for d in 0..6 {
         let mut below: Vec<[f32; 4]> = base
             .iter()
             .zip(&normals)
-            .map(|(v, n)| v.map(|c| c * reference::facing_weight(*n, d)))
+            .map(|(v, n)| reference::seen_facing(*n, *v, d))
             .collect();
         let mut size = n;
         // n/2 down to 2.

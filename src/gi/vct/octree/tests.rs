@@ -601,18 +601,11 @@ fn bricks_filter_and_borders_match_cpu() {
                     std::array::from_fn(|i| a[i] * layout::OCTREE_ATTRIBUTE_BRICK + k[i]);
                 let word =
                     normals[(nt[0] + attribute_edge * (nt[1] + attribute_edge * nt[2])) as usize];
-                let nrm = glam::Vec3::new(
-                    (word & 0xff) as f32,
-                    ((word >> 8) & 0xff) as f32,
-                    ((word >> 16) & 0xff) as f32,
-                ) / 127.5
-                    - 1.0;
-                let w = if facing {
-                    reference::facing_weight(nrm, dir as usize)
+                if facing {
+                    reference::seen_facing(word, v, dir as usize)
                 } else {
-                    1.0
-                };
-                v.map(|x| x * w)
+                    v
+                }
             } else {
                 interior.at(brick_texel(brick, p.interior_side, t, dir))
             };
