@@ -527,6 +527,142 @@ fn first_bounce_holds_its_total_as_the_voxels_get_finer() {
     }
 }
 
+/// `conference_main`'s point light, as a scene file in `dir` with the `[camera]` table
+/// `camera`.
+fn conference_with_camera(dir: &Path, camera: &str) -> PathBuf {
+    let obj = shared().join("scenes/conference/conference.obj");
+    write(
+        dir,
+        "conference.toml",
+        &format!(
+            "{camera}[[mesh]]\npath = {obj:?}\n[[light]]\nkind = \"point\"\n\
+             position = [330, 600, -190]\nintensity = [400000, 400000, 400000]\n"
+        ),
+    )
+}
+
+/// The floor under the conference table, in its shadow, 70 from the table's edge: what
+/// the cone along its normal gathers (`--cone 0`, one bounce), against the path tracer's
+/// exact cone (0.003: it sees the table's unlit underside and the frame below it). Above
+/// the table, the ceiling over the light is lit about 70 times as brightly as the floor,
+/// so whatever of the table the cone sees through shows.
+#[test]
+#[cfg_attr(
+    voxcone_shared,
+    ignore = "issue 20: 0.35 at 64³ and 0.17 at 256³, against 0.003 (session 27)"
+)]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn floor_under_the_conference_table_sees_through_none_of_it() {
+    let dir = temp_dir("components_conference_table");
+    let scene = conference_with_camera(
+        &dir,
+        "[camera]\nposition = [141.8, 100, -140]\ntarget = [141.8, -1.6, -146.1]\nfov_y_deg = 10\n",
+    );
+    let centre_of = |p: &Path| {
+        let (image, _) = load_rgb(p).unwrap();
+        at_row(&image, image.height as usize / 2)
+    };
+    let path = dir.join("path.exr");
+    render_path(
+        &scene,
+        &[
+            "--size",
+            "64x64",
+            "--spp",
+            "1024",
+            "--max-depth",
+            "3",
+            "--cone",
+            "0",
+        ],
+        &path,
+    );
+    let exact = centre_of(&path);
+    for voxels in [64, 256] {
+        let out = dir.join(format!("cone_{voxels}.exr"));
+        render(
+            &scene,
+            &[
+                "--size",
+                "64x64",
+                "--gi",
+                "dense",
+                "--voxels",
+                &voxels.to_string(),
+                "--bounces",
+                "1",
+                "--cone",
+                "0",
+            ],
+            &out,
+        );
+        let ours = centre_of(&out);
+        eprintln!("floor under the table, {voxels}³: cone 0 gathers {ours:.4}, the path tracer {exact:.4}");
+        assert!(ours - exact <= 0.03, "{voxels}³: {ours} against {exact}");
+    }
+}
+
+/// `conference_main`'s walls (rows 64 to 128 of the view, at 128x128): what the cone along
+/// their normal gathers with one bounce (`--cone 0`), within 10 % of the path tracer's
+/// exact cone. It looks across the room, so it reads the coarsest levels, whose cells
+/// are taller than the room.
+#[test]
+#[cfg_attr(
+    voxcone_shared,
+    ignore = "issue 20: 0.562 of the path tracer's at 64³, 0.464 at 256³ (session 27)"
+)]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn conference_walls_cone_along_the_normal_matches_the_path_tracer() {
+    let scene = shared().join("reference/conference_main.scene.json");
+    let dir = temp_dir("components_conference_walls");
+    let size = ["--size", "128x128"];
+    let rows = |p: &Path| {
+        let (image, _) = load_rgb(p).unwrap();
+        image.data[32 * 128 * 3..64 * 128 * 3]
+            .iter()
+            .map(|&c| f64::from(c))
+            .sum::<f64>()
+    };
+    let path = dir.join("path.exr");
+    render_path(
+        &scene,
+        &[
+            &size[..],
+            &["--spp", "64", "--max-depth", "3", "--cone", "0"],
+        ]
+        .concat(),
+        &path,
+    );
+    let off = dir.join("off.exr");
+    render(&scene, &[&size[..], &["--gi", "off"]].concat(), &off);
+    let exact = rows(&path);
+    for voxels in [64, 256] {
+        let out = dir.join(format!("cone_{voxels}.exr"));
+        let v = voxels.to_string();
+        render(
+            &scene,
+            &[
+                &size[..],
+                &[
+                    "--gi",
+                    "dense",
+                    "--voxels",
+                    &v,
+                    "--bounces",
+                    "1",
+                    "--cone",
+                    "0",
+                ],
+            ]
+            .concat(),
+            &out,
+        );
+        let ratio = (rows(&out) - rows(&off)) / exact;
+        eprintln!("conference walls, {voxels}³: cone 0 gathers {ratio:.3} of the path tracer's");
+        assert!((ratio - 1.0).abs() <= 0.1, "{voxels}³: {ratio}");
+    }
+}
+
 /// Convergence: LDR-FLIP against each reference at 128³ is no higher than at 64³ (within
 /// 0.003), `--gi dense` at default settings but the resolution.
 #[test]
