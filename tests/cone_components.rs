@@ -544,7 +544,7 @@ fn conference_with_camera(dir: &Path, camera: &str) -> PathBuf {
 /// The floor under the conference table, in its shadow, 70 from the table's edge: what
 /// the cone along its normal gathers (`--cone 0`, one bounce), against the path tracer's
 /// exact cone (0.003: it sees the table's unlit underside and the frame below it). Above
-/// the table, the ceiling over the light is lit about 70 times as brightly as the floor,
+/// the table, the ceiling over the light is lit about 150 times as brightly as the floor,
 /// so whatever of the table the cone sees through shows.
 #[test]
 #[cfg_attr(
