@@ -14,9 +14,14 @@ use voxcone::imageio::{load_rgb, RgbImage};
 /// Mean over the channels of the centre 8x8 pixels.
 fn centre(path: &Path) -> f32 {
     let (image, _) = load_rgb(path).unwrap();
-    let (w, h) = (image.width as usize, image.height as usize);
+    at_row(&image, image.height as usize / 2)
+}
+
+/// Mean over the channels of the 8x8 pixels centred on row `y` of the middle column.
+fn at_row(image: &RgbImage, y: usize) -> f32 {
+    let w = image.width as usize;
     let mut sum = 0.0;
-    for y in h / 2 - 4..h / 2 + 4 {
+    for y in y - 4..y + 4 {
         for x in w / 2 - 4..w / 2 + 4 {
             sum += image.data[(y * w + x) * 3..(y * w + x) * 3 + 3]
                 .iter()
@@ -336,20 +341,6 @@ fn floor_beside_an_emissive_wall_matches_the_path_tracer() {
     }
 }
 
-/// Mean over the channels of the 8x8 pixels centred on row `y` of the middle column.
-fn at_row(image: &RgbImage, y: usize) -> f32 {
-    let w = image.width as usize;
-    let mut sum = 0.0;
-    for y in y - 4..y + 4 {
-        for x in w / 2 - 4..w / 2 + 4 {
-            sum += image.data[(y * w + x) * 3..(y * w + x) * 3 + 3]
-                .iter()
-                .sum::<f32>();
-        }
-    }
-    sum / 192.0
-}
-
 /// A table under a black sky, lit from straight above by a directional light of
 /// irradiance 3: a floor 6 x 6 of albedo 0.5 and over its middle at height 0.5 a top
 /// 2 x 2 of albedo 0.8, two faces 0.004 apart (inside one voxel at 64³ and 128³). A low
@@ -558,10 +549,6 @@ fn floor_under_the_conference_table_sees_through_none_of_it() {
         &dir,
         "[camera]\nposition = [141.8, 100, -140]\ntarget = [141.8, -1.6, -146.1]\nfov_y_deg = 10\n",
     );
-    let centre_of = |p: &Path| {
-        let (image, _) = load_rgb(p).unwrap();
-        at_row(&image, image.height as usize / 2)
-    };
     let path = dir.join("path.exr");
     render_path(
         &scene,
@@ -577,7 +564,7 @@ fn floor_under_the_conference_table_sees_through_none_of_it() {
         ],
         &path,
     );
-    let exact = centre_of(&path);
+    let exact = centre(&path);
     for voxels in [64, 256] {
         let out = dir.join(format!("cone_{voxels}.exr"));
         render(
@@ -596,7 +583,7 @@ fn floor_under_the_conference_table_sees_through_none_of_it() {
             ],
             &out,
         );
-        let ours = centre_of(&out);
+        let ours = centre(&out);
         eprintln!("floor under the table, {voxels}³: cone 0 gathers {ours:.4}, the path tracer {exact:.4}");
         assert!(ours - exact <= 0.03, "{voxels}³: {ours} against {exact}");
     }
