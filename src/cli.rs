@@ -145,8 +145,8 @@ pub struct CommonArgs {
     /// cone along the normal, 1 to --diffuse-cones - 1 the ring's. --gi dense and --gi
     /// octree trace that cone alone for the indirect light (albedo times its radiance);
     /// --gi path shows albedo times the exact mean radiance within it (one bounce with
-    /// --max-depth 3), instead of the image, for the layout that --diffuse-cones and
-    /// --diffuse-aperture give.
+    /// --max-depth 3), instead of the image, for the layout that --diffuse-cones,
+    /// --diffuse-aperture and --cosine-cones give.
     #[arg(long)]
     pub cone: Option<u32>,
 }
@@ -393,7 +393,7 @@ impl CommonArgs {
         if !matches!(self.gi, GiMode::Dense | GiMode::Octree) {
             // The path tracer's cone component takes the gather's layout, so that the
             // exact cones of any layout can be rendered.
-            let layout = ["--diffuse-cones", "--diffuse-aperture"];
+            let layout = ["--diffuse-cones", "--diffuse-aperture", "--cosine-cones"];
             let path_cone = self.gi == GiMode::Path && self.cone.is_some();
             if let Some(option) = self
                 .vct
@@ -425,6 +425,7 @@ impl CommonArgs {
                         index,
                         ring: cones.diffuse_cones - 1,
                         aperture_deg: cones.diffuse_aperture_deg,
+                        cosine: cones.cosine_cones,
                     });
                 }
                 GiSettings::Path(settings)

@@ -538,8 +538,8 @@ gpu_layout! {
         uint static_sums,
         /// The one diffuse cone the screen's gather traces, its radiance alone (`--cone`: 0 along the normal, 1.. the ring's), or 0xffffffff for the whole gather.
         uint only_cone,
-        /// Pads the struct to a multiple of 16 bytes.
-        uint pad1,
+        /// 1: the diffuse gather weighs its cones by the cosine (`--cosine-cones`): the ring cones' sub-cones by their axes' cosine to the normal, each cone by its region's share of the cosine-weighted hemisphere; 0: each cone's plain mean, 1 along the normal and 1/2 in the ring.
+        uint cosine_cones,
         /// Pads the struct to a multiple of 16 bytes.
         uint pad2,
     }
@@ -810,14 +810,14 @@ gpu_layout! {
         uint seed,
         /// 1: cut-outs stop shadow rays whatever their coverage (the references' convention: their next-event estimation ignores Mitsuba's masks).
         uint opaque_shadow_cut_outs,
-        /// The cone component (`--cone`): the camera's hit gathers albedo times the mean radiance within the cone tracer's diffuse cone `cone` (0 along the normal, 1..`ring` the ring's), sampled uniformly, instead of its light; 0xffffffff for none.
+        /// The cone component (`--cone`): the camera's hit gathers albedo times the mean radiance within the cone tracer's diffuse cone `cone` (0 along the normal, 1..`ring` the ring's), weighted by the cosine to the normal where `cone_cosine` is 1, instead of its light; 0xffffffff for none.
         uint cone,
         /// Cones in the diffuse gather's ring.
         uint ring,
         /// cos of the diffuse cones' half aperture.
         float cone_cos_half,
-        /// Pads the struct to a multiple of 16 bytes.
-        uint pad0,
+        /// 1: the cone component weighs its rays by the cosine to the normal, as `--cosine-cones` weighs the gather's cones; 0: their plain mean.
+        uint cone_cosine,
     }
 
     /// Push constants of the path tracer: this dispatch's share of the samples.

@@ -461,10 +461,12 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                 override_if(&mut args.voxels, voxels, vct.voxels);
             }
             let mut wide = vct.cones.wide_steps_by_level;
+            let mut cosine = vct.cones.cosine_cones;
             let mut accumulate = vct.cones.accumulate_bounces;
             let mut full_update = vct.full_update;
             let mut voxelizer = vct.voxelizer;
             settle(ui.checkbox(&mut wide, "wide steps by level"));
+            settle(ui.checkbox(&mut cosine, "cosine-weighted cones"));
             settle(ui.checkbox(&mut accumulate, "accumulate bounces over frames"));
             settle(ui.checkbox(&mut full_update, "voxelize everything every frame"));
             egui::ComboBox::from_label("voxelizer")
@@ -475,6 +477,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                     }
                 });
             args.wide_steps_by_level = wide;
+            args.cosine_cones = cosine;
             args.no_accumulate = !accumulate;
             args.full_update = full_update;
             if voxelizer != vct.voxelizer {

@@ -365,8 +365,13 @@ bool extend(inout Path p) {
             return false;
         }
         // Uniform within the cone: the mean radiance over it, times albedo as the
-        // composite multiplies the gathered light.
-        p.throughput *= s.albedo;
+        // composite multiplies the gathered light. With `--cosine-cones` each ray
+        // counts by its cosine to the normal over the cosine's mean over the cone,
+        // cos(axis) (1 + cos(half-angle)) / 2: the cosine-weighted mean radiance in
+        // the cone, which the gather's cone then stands for.
+        float mean_cos = dot(s.ns, axis) * 0.5 * (1.0 + path.cone_cos_half);
+        float weight = path.cone_cosine != 0u ? max(dot(s.ns, next), 0.0) / mean_cos : 1.0;
+        p.throughput *= s.albedo * weight;
         p.bsdf_pdf = 0.0;
         p.origin = s.p + s.ng * rays.epsilon;
         p.dir = next;

@@ -218,6 +218,14 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
 // they stand for, so a sub-cone costs about one cone (stepping by their own width is
 // slightly better and twice as slow; the counts, widths and what is split are the best
 // of the sweeps in BENCHMARKS.md, session 11).
+// With `--cosine-cones`: a ring cone spans 27.5 to 87.5 degrees from the normal, where
+// the cosine falls from 0.89 to 0.04, and stands for the cosine-weighted irradiance
+// integral over its part of the hemisphere. Its sub-cones lie towards and away from the
+// normal (two up to ten ring cones: one each way), and each counts by the cosine of its
+// axis, so that the cone's grazing side counts as little as it does in the integral;
+// the path tracer's cone component weighs its rays the same way. Without it the
+// sub-cones lie in a frame fixed to the world's y axis (laid out along and across the
+// ring they score no better) and count alike.
 vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surface, vec3 n, float step_factor,
                      int ao_volume) {
     if (parts == 1) {
@@ -225,18 +233,22 @@ vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surfa
     }
     float offset = atan(vct.diffuse_tan_half) * (parts == 4 ? 0.467 : 0.4);
     float tan_half = vct.diffuse_tan_half * (parts == 4 ? 0.53 : 0.63);
-    // Evenly round the axis, half a step off a frame fixed to the world's y axis (laid
-    // out along and across the ring instead they score no better: BENCHMARKS.md).
-    vec3 u = perpendicular(dir);
-    vec3 v = cross(dir, u);
+    bool cosine = vct.cosine_cones != 0u;
+    // With cosine weights, u runs across the ring and v along its meridian, towards n.
+    vec3 v = cosine ? normalize(n - dot(n, dir) * dir) : vec3(0.0);
+    vec3 u = cosine ? cross(v, dir) : perpendicular(dir);
+    v = cosine ? v : cross(dir, u);
     vec4 sum = vec4(0.0);
+    float weights = 0.0;
     for (int i = 0; i < parts; i++) {
         float phi = 6.2831853 * (float(i) + 0.5) / float(parts);
         vec3 d = normalize(cos(offset) * dir + sin(offset) * (cos(phi) * u + sin(phi) * v));
-        sum += trace_cone(origin, d, tan_half, min_lod, surface, n, ao_volume,
-                          step_factor * vct.diffuse_tan_half / tan_half);
+        float w = cosine ? max(dot(d, n), 0.0) : 1.0;
+        sum += w * trace_cone(origin, d, tan_half, min_lod, surface, n, ao_volume,
+                              step_factor * vct.diffuse_tan_half / tan_half);
+        weights += w;
     }
-    return sum / float(parts);
+    return weights > 0.0 ? sum / weights : vec4(0.0);
 }
 
 // Cosine-weighted mean radiance over the hemisphere around n of the surface at `surface`
@@ -275,14 +287,20 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
     if (only > 0) {
         return vec4(around.rgb, 1.0);
     }
-    // Cosine weights: a cone of half-angle 30 degrees at angle a from n holds
-    // pi sin^2(30) cos(a) of the cosine-weighted hemisphere: pi/4 along n, about pi/8 in
-    // the ring. Five such cones fill the ring; more overlap and share the ring's
-    // pi * 5/8, so its share does not grow with the count (the gaps towards the horizon
-    // are filled in proportion). (The band's own share, 3/4 against the cap's 1/4, scores
-    // worse with the traced cones: BENCHMARKS.md, session 11.)
+    // With `--cosine-cones` each cone stands for its part of the hemisphere, weighted by
+    // that part's share of the cosine-weighted integral: the cone along n for the cap it
+    // covers, of half-angle h, which holds sin^2(h) of it (1/4 at the default 60
+    // degrees), the ring's cones evenly for the band from h to the horizon, gaps and
+    // overlaps included.
+    // Without it, cosine weights of the cones themselves: a cone of half-angle 30
+    // degrees at angle a from n holds pi sin^2(30) cos(a) of the cosine-weighted
+    // hemisphere: pi/4 along n, about pi/8 in the ring. Five such cones fill the ring;
+    // more overlap and share the ring's pi * 5/8, so its share does not grow with the
+    // count (the gaps towards the horizon are filled in proportion).
+    float t2 = vct.diffuse_tan_half * vct.diffuse_tan_half;
     float ring_share = 0.5 * float(min(ring, 5));
-    vec4 sum = (centre + ring_share * around / float(ring)) / (1.0 + ring_share);
+    float cap_share = vct.cosine_cones != 0u ? t2 / (1.0 + t2) : 1.0 / (1.0 + ring_share);
+    vec4 sum = cap_share * centre + (1.0 - cap_share) * around / float(ring);
     return vec4(sum.rgb, 1.0 - sum.a);
 }
 #endif

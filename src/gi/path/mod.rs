@@ -53,6 +53,9 @@ pub struct ConeComponent {
     pub ring: u32,
     /// Full aperture, degrees.
     pub aperture_deg: f32,
+    /// The rays weighted by their cosine to the normal, as `--cosine-cones` weighs the
+    /// gather's cones.
+    pub cosine: bool,
 }
 
 /// The path tracer's settings.
@@ -71,8 +74,8 @@ pub struct PathSettings {
     /// coverage either way).
     pub opaque_shadow_cut_outs: bool,
     /// Instead of the image, albedo times the mean radiance within this cone of the cone
-    /// tracer's gather at each camera hit, its directions sampled uniformly: the exact
-    /// value of the one cone `--gi dense --cone` traces.
+    /// tracer's gather at each camera hit (cosine-weighted with `--cosine-cones`): the
+    /// exact value of the one cone `--gi dense --cone` traces.
     pub cone: Option<ConeComponent>,
 }
 
@@ -175,7 +178,7 @@ impl PathTracer {
             cone_cos_half: settings
                 .cone
                 .map_or(1.0, |c| (c.aperture_deg.to_radians() * 0.5).cos()),
-            ..Default::default()
+            cone_cosine: settings.cone.map_or(0, |c| u32::from(c.cosine)),
         };
         let uniforms = Buffer::with_data(
             ctx,

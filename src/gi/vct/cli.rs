@@ -37,6 +37,14 @@ pub struct VctArgs {
     /// last (Dřínovský's sampling of wide cones), instead of by the step factor.
     #[arg(long)]
     pub wide_steps_by_level: bool,
+    /// Weight the diffuse gather's cones by the cosine: each ring cone's sub-cones by the
+    /// cosine of their axis to the normal, each cone by its region's share of the
+    /// cosine-weighted hemisphere (the cone along the normal its cap's, sin² of the half
+    /// aperture; the ring the rest), and the path tracer's cone component (--cone) by the
+    /// cosine too. Off: each cone's plain mean, weighted 1 along the normal and 1/2 in the
+    /// ring.
+    #[arg(long)]
+    pub cosine_cones: bool,
     /// Diffuse cones per gather, 1 to 16: one along the normal, the rest in a ring at 57.5
     /// degrees, each traced on screen as narrower sub-cones [default: 6].
     #[arg(long)]
@@ -88,6 +96,7 @@ impl VctArgs {
             (self.bounce_step_factor.is_some(), "--bounce-step-factor"),
             (self.shadow_step_factor.is_some(), "--shadow-step-factor"),
             (self.wide_steps_by_level, "--wide-steps-by-level"),
+            (self.cosine_cones, "--cosine-cones"),
             (self.diffuse_cones.is_some(), "--diffuse-cones"),
             (self.indirect_scale.is_some(), "--indirect-scale"),
             (self.no_accumulate, "--no-accumulate"),
@@ -130,6 +139,7 @@ impl VctArgs {
                 .unwrap_or(d.shadow_step_factor),
             wide_steps_by_level: self.wide_steps_by_level
                 || scene.wide_steps_by_level.unwrap_or(d.wide_steps_by_level),
+            cosine_cones: self.cosine_cones || scene.cosine_cones.unwrap_or(d.cosine_cones),
             accumulate_bounces: !self.no_accumulate,
             shadow_aperture_deg: self
                 .shadow_aperture

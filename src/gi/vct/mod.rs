@@ -376,6 +376,7 @@ impl<S: VoxelStore> ConeTracing<S> {
             wide_steps_by_level: u32::from(cones.wide_steps_by_level),
             static_sums: u32::from(store.static_sums()),
             only_cone: cones.only_cone.unwrap_or(u32::MAX),
+            cosine_cones: u32::from(cones.cosine_cones),
             ..Default::default()
         };
         let uniforms = Buffer::with_data(

@@ -65,6 +65,11 @@ pub struct ConeSettings {
     /// instead of by `step_factor` (or, in the voxel bounce, `bounce_step_factor`) of
     /// their diameter.
     pub wide_steps_by_level: bool,
+    /// The diffuse gather weighs its cones by the cosine (`--cosine-cones`): the ring
+    /// cones' sub-cones by their axes' cosine to the normal, each cone by its region's
+    /// share of the cosine-weighted hemisphere. Off by default: the plain quadrature's
+    /// errors still balance the tracer's (BENCHMARKS.md, session 28).
+    pub cosine_cones: bool,
     /// Light bounces between voxels: 1 is direct light on the voxels only.
     pub bounces: u32,
     /// Indirect light is traced on one pixel of each `indirect_scale`² block and
@@ -174,6 +179,7 @@ impl Default for ConeSettings {
             bounce_step_factor: 0.5,
             shadow_step_factor: 0.5,
             wide_steps_by_level: false,
+            cosine_cones: false,
             bounces: 8,
             indirect_scale: None,
             accumulate_bounces: true,
