@@ -369,8 +369,10 @@ bool extend(inout Path p) {
         // counts by its cosine to the normal over the cosine's mean over the cone,
         // cos(axis) (1 + cos(half-angle)) / 2: the cosine-weighted mean radiance in
         // the cone, which the gather's cone then stands for.
-        float mean_cos = dot(s.ns, axis) * 0.5 * (1.0 + path.cone_cos_half);
-        float weight = path.cone_cosine != 0u ? max(dot(s.ns, next), 0.0) / mean_cos : 1.0;
+        float weight = 1.0;
+        if (path.cone_cosine != 0u) {
+            weight = max(dot(s.ns, next), 0.0) / (dot(s.ns, axis) * 0.5 * (1.0 + path.cone_cos_half));
+        }
         p.throughput *= s.albedo * weight;
         p.bsdf_pdf = 0.0;
         p.origin = s.p + s.ng * rays.epsilon;

@@ -234,10 +234,16 @@ vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surfa
     float offset = atan(vct.diffuse_tan_half) * (parts == 4 ? 0.467 : 0.4);
     float tan_half = vct.diffuse_tan_half * (parts == 4 ? 0.53 : 0.63);
     bool cosine = vct.cosine_cones != 0u;
-    // With cosine weights, u runs across the ring and v along its meridian, towards n.
-    vec3 v = cosine ? normalize(n - dot(n, dir) * dir) : vec3(0.0);
-    vec3 u = cosine ? cross(v, dir) : perpendicular(dir);
-    v = cosine ? v : cross(dir, u);
+    vec3 u;
+    vec3 v;
+    if (cosine) {
+        // u across the ring, v along its meridian, towards n.
+        v = normalize(n - dot(n, dir) * dir);
+        u = cross(v, dir);
+    } else {
+        u = perpendicular(dir);
+        v = cross(dir, u);
+    }
     vec4 sum = vec4(0.0);
     float weights = 0.0;
     for (int i = 0; i < parts; i++) {
