@@ -116,16 +116,24 @@ gpu_layout! {
         BINDING_VCT_INDICES = 10;
         /// Workgroup size of the compute voxelization: the lanes that walk one triangle's pixels.
         VOXELIZE_GROUP_SIZE = 32;
+        /// Voxel cone tracing (set 3): the emitters whose light is sampled instead of gathered
+        /// (`gi::vct::emitters`), `VctEmitter[]` storage buffer (`VctUniforms.emitter_count` of them).
+        BINDING_VCT_EMITTERS = 11;
+        /// Voxel cone tracing (set 3): the sampled emitters' triangles, `VctEmitterTriangle[]` storage buffer.
+        BINDING_VCT_EMITTER_TRIANGLES = 12;
+        /// Voxel cone tracing (set 3): one bit per material (bit m % 32 of word m / 32), set where its
+        /// emission is sampled and so left out of the voxels, `uint[]` storage buffer.
+        BINDING_VCT_SAMPLED_MATERIALS = 13;
 
         /// Dense grid (set 3, after the shared bindings): per voxel, the sums of its fragments'
         /// albedo, normal and emission (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` texels
         /// of an `r32ui` storage image of 2n x n x 5n texels (`glsl/gi/vct/sums.glsl`), from which the
         /// compact pass takes the means. Atomic adds are exact and commutative, so the means do not
         /// depend on the order in which fragments arrive.
-        BINDING_DENSE_SUMS = 11;
+        BINDING_DENSE_SUMS = 14;
         /// Dense grid (set 3): the static meshes' fragment sums, laid out as `BINDING_DENSE_SUMS`
         /// (read when `VctUniforms.static_sums` is 1).
-        BINDING_DENSE_STATIC_SUMS = 12;
+        BINDING_DENSE_STATIC_SUMS = 15;
         /// Dense filter pass (its own set 2, one per level): the base radiance, read by the first level, `rgba16f` storage.
         BINDING_FILTER_BASE = 0;
         /// Dense filter pass (its own set 2, one per level): the directional level read (levels after the first), `rgba16f` storage.
@@ -140,33 +148,33 @@ gpu_layout! {
         /// Octree (set 3, after the shared bindings, in which the octree binds its pools where the
         /// dense grid binds volumes): `OctreeCounters` then `OctreeLevel[OCTREE_MAX_LEVELS]`,
         /// storage buffer.
-        BINDING_OCTREE_COUNTERS = 11;
+        BINDING_OCTREE_COUNTERS = 14;
         /// Octree (set 3): the voxel-fragment list, first half: the fragments' voxels (x | y << 10 | z << 20), then their RGBA8 albedos (from `OctreeCounters.fragment_capacity` on; the octree's passes read only the voxels), `uint[]` storage buffer. (Two halves of 8 bytes, so that each fits the 128 MiB that lavapipe binds at depth 9.)
-        BINDING_OCTREE_FRAGMENTS = 12;
+        BINDING_OCTREE_FRAGMENTS = 15;
         /// Octree (set 3): the voxel-fragment list, second half: per fragment its RGBA8 normal (xyz * 0.5 + 0.5) and emission / `VctUniforms.emission_range`, `uvec2[]` storage buffer.
-        BINDING_OCTREE_FRAGMENT_SHADING = 13;
+        BINDING_OCTREE_FRAGMENT_SHADING = 16;
         /// Octree (set 3): per node, its first child (children come in tiles of 8; 0 = none) with `OCTREE_SUBDIVIDE` set while flagged; for a leaf, which of its 8 voxels hold fragments (bits 0-7, voxel x | y << 1 | z << 2) and the first of their sums (bits 8-31; a leaf is flagged in its coordinates instead, `OCTREE_LEAF_FLAGGED`), `uint[]` storage buffer.
-        BINDING_OCTREE_NODES = 14;
+        BINDING_OCTREE_NODES = 17;
         /// Octree (set 3): per node, its coordinates among its level's nodes (x | y << 10 | z << 20), `uint[]` storage buffer.
-        BINDING_OCTREE_NODE_COORDS = 15;
+        BINDING_OCTREE_NODE_COORDS = 18;
         /// Octree (set 3): per node, its brick (`OCTREE_NO_BRICK` for an empty node), in the leaf pools for leaves, in the interior pool otherwise, `uint[]` storage buffer.
-        BINDING_OCTREE_NODE_BRICKS = 16;
+        BINDING_OCTREE_NODE_BRICKS = 19;
         /// Octree (set 3): per node, its six neighbours at its level (+X -X +Y -Y +Z -Z; `OCTREE_NO_NODE` where none), `uint[]` storage buffer.
-        BINDING_OCTREE_NEIGHBOURS = 17;
+        BINDING_OCTREE_NEIGHBOURS = 20;
         /// Octree (set 3): the interior bricks' six directional radiances, `rgba16f` storage (sampled at `BINDING_VCT_DIRECTIONAL`).
-        BINDING_OCTREE_DIRECTIONAL_STORAGE = 18;
+        BINDING_OCTREE_DIRECTIONAL_STORAGE = 21;
         /// Octree (set 3): per occupied leaf voxel, the sums of its fragments' albedo, normal and emission (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` words of a `uint[]` storage buffer: atomic adds are exact and commutative, so the averages do not depend on the order the fragments were listed in.
-        BINDING_OCTREE_SUMS = 19;
+        BINDING_OCTREE_SUMS = 22;
         /// Octree (set 3): the light each leaf voxel in a new brick gathered in the last frame, for the same voxel in the next frame's octree rebuilt around moving meshes (which gives it a new brick again): two hash tables of `carry_capacity` entries (key = voxel x | y << 10 | z << 20, plus 1; then the RGB floats), `uint[]` storage buffer.
-        BINDING_OCTREE_CARRY = 20;
+        BINDING_OCTREE_CARRY = 23;
         /// Octree (set 3): the static part's child entries as the static build left them (Dřínovský 2013, 5.7): each frame restores them, and a static leaf that a moving mesh's fragments reach reads its own voxels' mask and sums from here, `uint[]` storage buffer.
-        BINDING_OCTREE_STATIC_NODES = 21;
+        BINDING_OCTREE_STATIC_NODES = 24;
         /// Octree (set 3): per brick (the leaf bricks', then the interior bricks'), `OCTREE_CHANGED` and `OCTREE_BORDER` bits while the filter's update lists are built, `uint[]` storage buffer.
-        BINDING_OCTREE_CHANGES = 22;
+        BINDING_OCTREE_CHANGES = 25;
         /// Octree (set 3): the filter's update lists (Dřínovský 2013, 5.5): `OctreeUpdateList[OCTREE_UPDATE_LISTS]`, `OctreeBounceDispatch`, then each list's nodes (`OctreeCounters.update_capacity` each), `uint[]` storage buffer.
-        BINDING_OCTREE_UPDATES = 23;
+        BINDING_OCTREE_UPDATES = 26;
         /// Octree (set 3): the node grid, a dense index into the octree at level `depth - 1 - OCTREE_NODE_GRID_ABOVE_LEAVES` (`glsl/gi/vct/octree/nodes/grid.comp`): per cell, its node there, or `OCTREE_GRID_GAP` plus the level of the childless node above where its cube is empty; cone samples start their descent from it, `uint[]` storage buffer.
-        BINDING_OCTREE_NODE_GRID = 24;
+        BINDING_OCTREE_NODE_GRID = 27;
         /// Words of a voxel's fragment sums (dense grid and octree alike): albedo RGB, normal
         /// XYZ, emission RGB, then the fragment count (`glsl/gi/vct/sums.glsl`).
         VOXEL_SUM_WORDS = 10;
@@ -263,6 +271,8 @@ gpu_layout! {
         DEBUG_CLUSTERS = 8;
         /// `FrameUniforms.debug_view`: the probes as small spheres showing the mean radiance each sees, over the indirect light (`--gi probes`).
         DEBUG_PROBES = 9;
+        /// `FrameUniforms.debug_view`: the cone tracer's sampled emitters' light alone, times the albedo (`--gi dense`, `--gi octree`).
+        DEBUG_EMITTER_LIGHT = 10;
 
         /// Scene ray casting (the first bindings of a set 3 that casts rays,
         /// `glsl/ray/rays.glsl`): `RayUniforms` uniform buffer.
@@ -540,8 +550,34 @@ gpu_layout! {
         uint only_cone,
         /// 1: the diffuse gather weighs its cones by the cosine (`--cosine-cones`): the ring cones' sub-cones by their axes' cosine to the normal, each cone by its region's share of the cosine-weighted hemisphere; 0: each cone's plain mean, 1 along the normal and 1/2 in the ring.
         uint cosine_cones,
-        /// Pads the struct to a multiple of 16 bytes.
-        uint pad2,
+        /// Entries of `BINDING_VCT_EMITTERS`: the emitters whose light the cones' passes sample.
+        uint emitter_count,
+    }
+
+    /// A planar group of emissive triangles whose light voxel cone tracing samples: their exact unoccluded irradiance, times one soft-shadow cone's visibility (`glsl/gi/vct/emitters.glsl`).
+    struct VctEmitter {
+        /// xyz the unit normal the triangles emit along (their winding's), w its plane's offset: points x of the plane have dot(xyz, x) = w.
+        vec4 plane,
+        /// rgb the emitted radiance (Ke times the scene's scale), a unused.
+        vec4 radiance,
+        /// The first of its triangles in `BINDING_VCT_EMITTER_TRIANGLES`.
+        uint first_triangle,
+        /// How many triangles it has.
+        uint triangle_count,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+    }
+
+    /// A triangle of a sampled emitter, in world space, wound so that it emits along its emitter's plane normal.
+    struct VctEmitterTriangle {
+        /// xyz the first vertex, w unused.
+        vec4 v0,
+        /// xyz the second vertex, w unused.
+        vec4 v1,
+        /// xyz the third vertex, w unused.
+        vec4 v2,
     }
 
     /// What the upsample needs to know of the reduced-resolution terms a technique gathered.

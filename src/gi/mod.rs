@@ -97,6 +97,9 @@ pub enum DebugView {
     Lightmap,
     /// Each receiver's cluster in its own colour (`--gi probes` only).
     Clusters,
+    /// The light of the emitters the cone tracer samples, alone: their shadowed
+    /// irradiance times albedo / π (`--gi dense` and `--gi octree` only).
+    EmitterLight,
     /// The probes as small spheres showing the mean radiance each sees, over the indirect
     /// light (`--gi probes` only).
     Probes,
@@ -120,6 +123,7 @@ impl DebugView {
             DebugView::Lightmap => layout::DEBUG_LIGHTMAP,
             DebugView::Clusters => layout::DEBUG_CLUSTERS,
             DebugView::Probes => layout::DEBUG_PROBES,
+            DebugView::EmitterLight => layout::DEBUG_EMITTER_LIGHT,
         }
     }
 

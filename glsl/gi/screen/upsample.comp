@@ -12,7 +12,8 @@
 // - ambient occlusion on the indirect terms;
 // - transmission: transmissive pixels (d < 1) pass 1 - d of the refracted light,
 //   upsampled from the transmissive samples.
-// Each term follows its FLAG_*; the debug views show the indirect light or AO alone.
+// Each term follows its FLAG_*; the debug views show the indirect light, the cone
+// tracer's sampled emitters' light (which it gathers with its indirect light) or AO alone.
 // Nothing here reads a technique's own data, so one pipeline serves every technique.
 #include "common/direct_light.glsl"
 #include "gi/screen/screen.glsl"
@@ -177,6 +178,8 @@ void main() {
     vec3 result = surface;
     if (frame.debug_view == DEBUG_INDIRECT) {
         result = indirect_light + transmitted;
+    } else if (frame.debug_view == DEBUG_EMITTER_LIGHT) {
+        result = albedo_specular.rgb * gathered.rgb;
     } else if (frame.debug_view == DEBUG_AO) {
         result = vec3(gathered.a);
     }

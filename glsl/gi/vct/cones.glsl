@@ -207,6 +207,49 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
     return 1.0 - occlusion;
 }
 
+// tan of the half-angle of the cone whose solid angle is `solid` (a sampled emitter's
+// |phi|: gi/vct/emitters.glsl), no wider than a diffuse cone and no narrower than the
+// soft-shadow cones.
+float emitter_cone_tan(float solid) {
+    float cos_half = max(1.0 - solid / 6.2831853, 1.0 / sqrt(1.0 + vct.diffuse_tan_half * vct.diffuse_tan_half));
+    return max(sqrt(1.0 - cos_half * cos_half) / cos_half, vct.shadow_tan_half);
+}
+
+// Fraction of a sampled emitter's light (gi/vct/emitters.glsl) that reaches the surface
+// at `surface` (normal n) through the voxels: one cone from `origin` along `dir` of
+// half-angle atan(tan_half), up to the emitter's `plane`. No sample blends the voxels of either
+// end's surface, which would shadow the light with the emitter itself or the receiver.
+// A lookup in cells of size f blends cells reaching 1.5 f from it, and a surface's voxels
+// reach a voxel from it (dilated by the voxelization), so a sample at height h above
+// either plane reads cells no larger than (h - voxel) / 1.5; samples too near the
+// receiver for a voxel are skipped, and the march stops where one would reach the
+// emitter. Each step is `vct.shadow_step_factor` of the cells read.
+float emitter_visibility(vec3 origin, vec3 surface, vec3 n, vec3 dir, float tan_half, vec4 plane) {
+    float voxel = vct.origin.w;
+    float grid_size = voxel * float(vct.resolution);
+    float cos_plane = -dot(plane.xyz, dir);
+    float plane_dist = (dot(plane.xyz, origin) - plane.w) / max(cos_plane, 1e-6);
+    float occlusion = 0.0;
+    float dist = voxel;
+    while (occlusion < 0.99 && dist < vct.max_distance) {
+        vec3 x = origin + dir * dist;
+        float to_receiver = (dot(x - surface, n) - voxel) / 1.5;
+        float to_emitter = ((plane_dist - dist) * cos_plane - voxel) / 1.5;
+        vec3 uvw = (x - vct.origin.xyz) / grid_size;
+        if (to_emitter < voxel || !inside_grid(uvw)) {
+            break;
+        }
+        float footprint = voxel;
+        if (to_receiver >= voxel) {
+            footprint = min(max(voxel, 2.0 * tan_half * dist), min(to_receiver, to_emitter));
+            float s = sample_voxels(uvw, dir, log2(footprint / voxel)).a;
+            occlusion += (1.0 - occlusion) * (1.0 - pow(1.0 - clamp(s, 0.0, 0.9999), vct.shadow_step_factor));
+        }
+        dist += footprint * vct.shadow_step_factor;
+    }
+    return 1.0 - occlusion;
+}
+
 // The screen's ring cones are each traced as sub-cones, narrower cones around their
 // axis that read finer levels: a 60-degree cone leaving a surface blends, in its coarse
 // cells, the surface's own lit voxels and walls seen edge-on that its rays never meet,

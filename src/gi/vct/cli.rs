@@ -1,11 +1,13 @@
 //! The cone tracer's command-line options, flattened into every command's.
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 use clap::Args;
 
 use super::octree::check_depth;
 use super::voxelize::Voxelizer;
-use super::{check_voxels, ConeSettings, Store, VctSettings, DEFAULT_VOXELS};
+use super::{
+    check_voxels, ConeSettings, Store, VctSettings, DEFAULT_SAMPLED_EMITTERS, DEFAULT_VOXELS,
+};
 use crate::scene::GiOverrides;
 
 #[derive(Args, Debug, Clone, Default)]
@@ -78,6 +80,13 @@ pub struct VctArgs {
     /// by default static geometry is voxelized once and only moving meshes every frame.
     #[arg(long)]
     pub full_update: bool,
+    /// The most emissive triangles whose light is sampled, 0 to 1024: each shaded point adds
+    /// their exact irradiance times a soft-shadow cone's visibility, and their emission is
+    /// left out of the voxels. Only static, untextured, opaque emitters, and only where the
+    /// scene has at most this many triangles of them; the others' light, and every
+    /// emitter's with 0, is gathered through the voxels [default: 64].
+    #[arg(long)]
+    pub sampled_emitters: Option<u32>,
     /// How the scene is voxelized (both cover the same voxels)
     #[arg(long, value_enum, default_value_t)]
     pub voxelizer: Voxelizer,
@@ -104,6 +113,7 @@ impl VctArgs {
             (self.shadow_aperture.is_some(), "--shadow-aperture"),
             (self.ao_distance.is_some(), "--ao-distance"),
             (self.voxelizer != Voxelizer::Auto, "--voxelizer"),
+            (self.sampled_emitters.is_some(), "--sampled-emitters"),
         ]
         .into_iter()
         .filter_map(|(set, flag)| set.then_some(flag))
@@ -161,6 +171,13 @@ impl VctArgs {
             (voxels, Store::Dense)
         };
         check_voxels(voxels)?;
+        let sampled_emitters = self
+            .sampled_emitters
+            .or(scene.sampled_emitters)
+            .unwrap_or(DEFAULT_SAMPLED_EMITTERS);
+        if sampled_emitters > 1024 {
+            bail!("--sampled-emitters / sampled_emitters must be at most 1024, got {sampled_emitters}");
+        }
         Ok(VctSettings {
             voxels,
             store,
@@ -168,6 +185,7 @@ impl VctArgs {
             shadow_cones: self.shadow_cones || scene.shadow_cones.unwrap_or(false),
             full_update: self.full_update,
             voxelizer: self.voxelizer,
+            sampled_emitters,
         })
     }
 }

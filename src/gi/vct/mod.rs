@@ -11,6 +11,7 @@ pub mod cli;
 mod cone_trace;
 mod debug;
 pub mod dense;
+mod emitters;
 mod grid;
 mod inject;
 pub mod octree;
@@ -29,7 +30,8 @@ pub use self::dense::Dense;
 pub use self::grid::Grid;
 pub use self::octree::Octree;
 pub use self::settings::{
-    auto_indirect_scale, check_voxels, ConeSettings, Store, VctSettings, DEFAULT_VOXELS,
+    auto_indirect_scale, check_voxels, ConeSettings, Store, VctSettings, DEFAULT_SAMPLED_EMITTERS,
+    DEFAULT_VOXELS,
 };
 use super::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
@@ -160,12 +162,15 @@ pub trait VoxelStore: Sized + 'static {
     fn preparation(&self) -> Option<Preparation>;
 }
 
-/// The scene's largest emitted radiance: voxels store emission divided by it, in RGBA8.
-pub(crate) fn emission_range(scene: &Scene) -> f32 {
+/// The largest radiance the voxels' emission holds (the scene's, less the sampled
+/// emitters'): voxels store emission divided by it, in RGBA8.
+fn emission_range(scene: &Scene, sampled: &emitters::SampledEmitters) -> f32 {
     scene
         .materials
         .iter()
-        .map(|m| m.emission.max_element())
+        .enumerate()
+        .filter(|(i, _)| !sampled.samples_material(*i))
+        .map(|(_, m)| m.emission.max_element())
         .fold(0.0f32, f32::max)
         .max(1e-6)
 }
@@ -195,6 +200,9 @@ fn shared_bindings() -> Vec<Binding> {
         Binding::new(layout::BINDING_VCT_DIRECTIONAL, sampled, STAGES),
         Binding::new(layout::BINDING_VCT_DIRECT, storage, STAGES),
         Binding::new(layout::BINDING_VCT_VOXEL_LIST, buffer, STAGES),
+        Binding::new(layout::BINDING_VCT_EMITTERS, buffer, STAGES),
+        Binding::new(layout::BINDING_VCT_EMITTER_TRIANGLES, buffer, STAGES),
+        Binding::new(layout::BINDING_VCT_SAMPLED_MATERIALS, buffer, STAGES),
         // The geometry the compute voxelizer reads.
         Binding::new(
             layout::BINDING_VCT_VERTICES,
@@ -310,6 +318,8 @@ pub struct ConeTracing<S: VoxelStore> {
     _sets: DescriptorSets,
     /// Referenced by the set.
     _uniforms: Buffer,
+    /// Referenced by the set: the sampled emitters, their triangles and materials.
+    _emitters: [Buffer; 3],
     /// Referenced by the set.
     _linear: Sampler,
     ctx: Arc<Context>,
@@ -360,11 +370,12 @@ impl<S: VoxelStore> ConeTracing<S> {
             linear.raw,
             frames_in_flight,
         )?;
+        let sampled = emitters::sampled_emitters(scene, settings.sampled_emitters);
         let uniforms = VctUniforms {
             origin: grid.origin.extend(grid.voxel_size).to_array(),
             resolution,
             directional_levels: directional_levels(resolution),
-            emission_range: emission_range(scene),
+            emission_range: emission_range(scene, &sampled),
             step_factor: cones.step_factor,
             bounce_step_factor: cones.bounce_step_factor,
             shadow_step_factor: cones.shadow_step_factor,
@@ -377,6 +388,7 @@ impl<S: VoxelStore> ConeTracing<S> {
             static_sums: u32::from(store.static_sums()),
             only_cone: cones.only_cone.unwrap_or(u32::MAX),
             cosine_cones: u32::from(cones.cosine_cones),
+            emitter_count: sampled.emitters.len() as u32,
             ..Default::default()
         };
         let uniforms = Buffer::with_data(
@@ -385,6 +397,33 @@ impl<S: VoxelStore> ConeTracing<S> {
             bytemuck::bytes_of(&uniforms),
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
+        // Never empty: a buffer of one unused entry where there is nothing to sample.
+        let emitter_buffer = |name: &str, bytes: &[u8], entry: usize| {
+            let zeros = vec![0u8; entry];
+            Buffer::with_data(
+                ctx,
+                name,
+                if bytes.is_empty() { &zeros } else { bytes },
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )
+        };
+        let emitter_buffers = [
+            emitter_buffer(
+                "vct emitters",
+                bytemuck::cast_slice(&sampled.emitters),
+                std::mem::size_of::<layout::VctEmitter>(),
+            )?,
+            emitter_buffer(
+                "vct emitter triangles",
+                bytemuck::cast_slice(&sampled.triangles),
+                std::mem::size_of::<layout::VctEmitterTriangle>(),
+            )?,
+            emitter_buffer(
+                "vct sampled materials",
+                bytemuck::cast_slice(&sampled.material_bits),
+                4,
+            )?,
+        ];
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         SetWriter::new(ctx, set)
             .buffer(
@@ -394,6 +433,21 @@ impl<S: VoxelStore> ConeTracing<S> {
             )
             .buffer(layout::BINDING_VCT_VERTICES, storage, gpu.vertices.raw)
             .buffer(layout::BINDING_VCT_INDICES, storage, gpu.indices.raw)
+            .buffer(
+                layout::BINDING_VCT_EMITTERS,
+                storage,
+                emitter_buffers[0].raw,
+            )
+            .buffer(
+                layout::BINDING_VCT_EMITTER_TRIANGLES,
+                storage,
+                emitter_buffers[1].raw,
+            )
+            .buffer(
+                layout::BINDING_VCT_SAMPLED_MATERIALS,
+                storage,
+                emitter_buffers[2].raw,
+            )
             .apply();
         Ok(Self {
             store,
@@ -409,6 +463,7 @@ impl<S: VoxelStore> ConeTracing<S> {
             set,
             _sets: sets,
             _uniforms: uniforms,
+            _emitters: emitter_buffers,
             _linear: linear,
             ctx: ctx.clone(),
         })

@@ -30,7 +30,13 @@ pub struct VctSettings {
     /// Re-voxelize and re-shade the static geometry every frame too (benchmarks).
     pub full_update: bool,
     pub voxelizer: Voxelizer,
+    /// The most emissive triangles whose light is sampled rather than gathered through the
+    /// voxels (`emitters`); 0 gathers every emitter's.
+    pub sampled_emitters: u32,
 }
+
+/// `VctSettings::sampled_emitters` unless the command line or the scene file says otherwise.
+pub const DEFAULT_SAMPLED_EMITTERS: u32 = 64;
 
 impl VctSettings {
     /// Default cones at `voxels` per axis in `store`.
@@ -42,6 +48,7 @@ impl VctSettings {
             shadow_cones: false,
             full_update: false,
             voxelizer: Voxelizer::default(),
+            sampled_emitters: DEFAULT_SAMPLED_EMITTERS,
         }
     }
 }

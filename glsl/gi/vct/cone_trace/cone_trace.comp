@@ -5,13 +5,14 @@
 // Voxel cone tracing (Crassin et al. 2011) for one G-buffer pixel of each
 // indirect_scale² block: cosine-weighted diffuse cones over the normal's hemisphere are
 // marched front to back through the voxel radiance, the sky filling what they leave
-// unoccluded (alpha: ambient occlusion); then the soft-shadow cones towards the lights,
+// unoccluded (alpha: ambient occlusion), and the sampled emitters' light is added; then the soft-shadow cones towards the lights,
 // the specular cone along the reflected view ray and, on transmissive surfaces, the
 // refraction cone. The upsample pass spreads the results to every pixel. Every cone is
 // traced here: a cone march compiled into the full-resolution upsample pass made it
 // twice as slow on lavapipe even where it never ran.
 #include "common/direct_light.glsl"
 #include "gi/vct/cones.glsl"
+#include "gi/vct/emitters.glsl"
 #include "gi/screen/screen.glsl"
 
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
@@ -19,6 +20,63 @@ layout(set = SET_SCREEN, binding = BINDING_SCREEN_INDIRECT, rgba16f) uniform wri
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_SHADOW, rgba16f) uniform writeonly image2D shadow;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_SPECULAR, rgba16f) uniform writeonly image2D specular;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_TRANSMITTED, rgba16f) uniform writeonly image2D transmitted;
+
+// Irradiance at the surface point p (normal n) from the sampled emitters, each shadowed by
+// a cone from `origin` along its phi, of the solid angle |phi|.
+vec3 sampled_emitter_light(vec3 p, vec3 origin, vec3 n) {
+    vec3 e = vec3(0.0);
+    for (uint i = 0u; i < vct.emitter_count; i++) {
+        VctEmitter emitter = vct_emitters[i];
+        vec3 phi = emitter_phi(emitter, p, n);
+        float cosine = dot(n, phi);
+        if (cosine > 0.0) {
+            float solid = length(phi);
+            e += emitter.radiance.rgb * cosine
+               * emitter_visibility(origin, p, n, phi / solid, emitter_cone_tan(solid), emitter.plane);
+        }
+    }
+    return e;
+}
+
+// The area of the intersection of two discs of radii a and b whose centres lie d apart.
+float disc_overlap(float a, float b, float d) {
+    if (d >= a + b) {
+        return 0.0;
+    }
+    if (d <= abs(a - b)) {
+        return PI * min(a, b) * min(a, b);
+    }
+    float lens = sqrt(max((-d + a + b) * (d + a - b) * (d - a + b) * (d + a + b), 0.0));
+    return a * a * acos(clamp((d * d + a * a - b * b) / (2.0 * d * a), -1.0, 1.0))
+         + b * b * acos(clamp((d * d + b * b - a * a) / (2.0 * d * b), -1.0, 1.0)) - 0.5 * lens;
+}
+
+// The sampled emitters' radiance averaged over the cone from `origin` along `dir` of
+// half-angle atan(tan_half) (a specular or refraction cone leaving the surface at p on
+// its `side`): the voxels the cone marches do not hold it. Each emitter covers the share
+// of the cone that a disc of its solid angle |phi| about phi's direction (phi over the
+// hemisphere about dir) covers of the cone's disc, both taken flat across dir (exact in
+// the limits of an emitter filling the cone or missing it); times its visibility along
+// the cone, no wider than the emitter.
+vec3 sampled_emitter_radiance(vec3 p, vec3 origin, vec3 side, vec3 dir, float tan_half) {
+    float cone = atan(tan_half);
+    vec3 radiance = vec3(0.0);
+    for (uint i = 0u; i < vct.emitter_count; i++) {
+        VctEmitter emitter = vct_emitters[i];
+        vec3 phi = emitter_phi(emitter, p, dir);
+        float solid = length(phi);
+        if (solid <= 0.0) {
+            continue;
+        }
+        float apart = acos(clamp(dot(dir, phi / solid), -1.0, 1.0));
+        float share = disc_overlap(sqrt(solid / PI), cone, apart) / (PI * cone * cone);
+        if (share > 0.0) {
+            float tan_visible = min(tan_half, emitter_cone_tan(solid));
+            radiance += emitter.radiance.rgb * share * emitter_visibility(origin, p, side, dir, tan_visible, emitter.plane);
+        }
+    }
+    return radiance;
+}
 
 void main() {
     ivec2 low = ivec2(gl_GlobalInvocationID.xy);
@@ -46,7 +104,16 @@ void main() {
     const bool with_ao = false;
 #endif
     vec3 start = p + n * (2.0 * vct.origin.w);
-    imageStore(indirect, low, gather_diffuse(p, start, n, int(vct.diffuse_cones), 1.0, with_ao, vct.step_factor, true, int(vct.only_cone)));
+    // The sampled emitters' light, which the voxels do not hold, joins the gathered
+    // radiance as the cosine-weighted mean it adds: E / pi (not with `--cone`, a cone's
+    // gather alone; alone in its debug view).
+    bool emitters_alone = frame.debug_view == DEBUG_EMITTER_LIGHT;
+    vec4 gathered = emitters_alone ? vec4(0.0, 0.0, 0.0, 1.0)
+                                   : gather_diffuse(p, start, n, int(vct.diffuse_cones), 1.0, with_ao, vct.step_factor, true, int(vct.only_cone));
+    if (vct.only_cone == 0xffffffffu) {
+        gathered.rgb += sampled_emitter_light(p, start, n) / PI;
+    }
+    imageStore(indirect, low, gathered);
     // Soft shadows change at the scale of the voxels, like the indirect light: their
     // cones are traced here too, four lights to a band of rows.
     if ((frame.flags & FLAG_SHADOW_CONES) != 0u) {
@@ -79,7 +146,10 @@ void main() {
         if (traced[c]) {
             // The cone leaves the surface on the side it points to.
             vec3 side = dot(dirs[c], n) < 0.0 ? -n : n;
-            radiance[c] = vec4(trace_cone(p + side * (2.0 * vct.origin.w), dirs[c], roughness, 0.0, p, side, -1, vct.step_factor).rgb, 1.0);
+            vec3 origin = p + side * (2.0 * vct.origin.w);
+            radiance[c] = vec4(trace_cone(origin, dirs[c], roughness, 0.0, p, side, -1, vct.step_factor).rgb
+                                   + sampled_emitter_radiance(p, origin, side, dirs[c], roughness),
+                               1.0);
         }
     }
     imageStore(specular, low, radiance[0]);

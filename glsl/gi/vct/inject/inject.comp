@@ -3,18 +3,22 @@
 // Deferred voxel shading (Villegas 2018), over the list of occupied voxels (the others
 // were cleared to zero): per occupied voxel, outgoing radiance =
 // albedo / pi * direct irradiance (the surface shading's units) + emission, stored
-// premultiplied by opacity. Visibility comes from the shadow maps (one bilinear compare:
-// a voxel is wider than the PCF kernel), or with soft-shadow cones, which make the
-// shadow maps unnecessary, from a ray marched through the voxels towards the light.
+// premultiplied by opacity. The sampled emitters' irradiance (gi/vct/emitters.glsl) joins
+// the lights', their emission being left out of the voxels. The lights' visibility comes
+// from the shadow maps (one bilinear compare: a voxel is wider than the PCF kernel), or
+// with soft-shadow cones, which make the shadow maps unnecessary, from a ray marched
+// through the voxels towards the light; the emitters' always from such a ray.
 // With OCTREE the voxels are the octree's leaf voxels, in their bricks. The radiance
 // is stored only where a bounce does not rewrite it before the next filter. Around
 // moving meshes (`push.cull`) only the voxels whose light can have changed are shaded
-// again: those in bricks given out this frame, and those a light reaches past where the
-// moving meshes were or are (`push.region_*`); the others keep their light.
+// again: those in bricks given out this frame, and those a light or a sampled emitter
+// reaches past where the moving meshes were or are (`push.region_*`); the others keep
+// their light.
 #include "common/frame.glsl"
 #include "common/direct_light.glsl"
 #include "gi/vct/voxels.glsl"
 #include "gi/vct/inject/radiance.glsl"
+#include "gi/vct/emitters.glsl"
 
 layout(local_size_x = VOXEL_LIST_GROUP_SIZE) in;
 layout(set = SET_GI, binding = BINDING_VCT_ALBEDO, r32ui) uniform readonly uimage3D voxel_albedo;
@@ -35,12 +39,12 @@ bool voxel_occupied(ivec3 v) {
 #endif
 }
 
-// Whether the segment from p (offset along n) towards the light, up to `dist`, passes no
-// occupied voxel: one sample per voxel length.
-float voxel_visibility(vec3 p, vec3 n, vec3 to_light, float dist) {
+// Whether the segment from p offset two voxels along n, towards the light, up to `end`
+// from there, passes no occupied voxel: one sample per voxel length.
+float voxel_visibility(vec3 p, vec3 n, vec3 to_light, float end) {
     float voxel = vct.origin.w;
     vec3 start = p + n * (2.0 * voxel);
-    float end = min(dist - voxel, vct.max_distance);
+    end = min(end, vct.max_distance);
     for (float t = 0.0; t < end; t += voxel) {
         ivec3 v = ivec3(floor((start + to_light * t - vct.origin.xyz) / voxel));
         if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(vct.resolution)))) {
@@ -120,6 +124,22 @@ bool light_may_change(vec3 p) {
             return true;
         }
     }
+    // The paths to a sampled emitter fill the hull of p and its triangles; their bounds
+    // hold it.
+    for (uint i = 0u; i < vct.emitter_count; i++) {
+        VctEmitter emitter = vct_emitters[i];
+        vec3 low = p;
+        vec3 high = p;
+        for (uint k = 0u; k < emitter.triangle_count; k++) {
+            VctEmitterTriangle t = vct_emitter_triangles[emitter.first_triangle + k];
+            low = min(low, min(t.v0.xyz, min(t.v1.xyz, t.v2.xyz)));
+            high = max(high, max(t.v0.xyz, max(t.v1.xyz, t.v2.xyz)));
+        }
+        float margin = 4.0 * voxel;
+        if (all(lessThanEqual(low, hi + margin)) && all(greaterThanEqual(high, lo - margin))) {
+            return true;
+        }
+    }
     return false;
 }
 #endif
@@ -134,7 +154,40 @@ vec3 voxel_irradiance(GpuLight light, vec3 p, vec3 n) {
         return e;
     }
     bool cones = (frame.flags & FLAG_SHADOW_CONES) != 0u;
-    return e * (cones ? voxel_visibility(p, n, l, dist) : shadow_visibility(light, p, n, 0.5 * vct.origin.w, 0));
+    return e * (cones ? voxel_visibility(p, n, l, dist - vct.origin.w) : shadow_visibility(light, p, n, 0.5 * vct.origin.w, 0));
+}
+
+// Irradiance at the voxel p on its side with (averaged) normal n from sampled emitter
+// `emitter` (gi/vct/emitters.glsl), weighted per axis face as the lights' (Villegas), and
+// shadowed by a ray through the voxels along its phi that stops 1.5 voxels short of its
+// plane, where the emitter's own voxels begin. None within a voxel of its plane: a
+// voxel's centre lies up to a voxel from its surfaces, and there it stands for the
+// emitter itself or the surface behind it that holds it (a ceiling), which would see
+// the emitter from a hair's breadth and take nearly pi times its radiance.
+vec3 voxel_emitter_irradiance(VctEmitter emitter, vec3 p, vec3 n) {
+    if (dot(emitter.plane.xyz, p) - emitter.plane.w < vct.origin.w) {
+        return vec3(0.0);
+    }
+    vec3 w = n * n;
+    vec3 phi = vec3(0.0);
+    float cosine = 0.0;
+    for (int a = 0; a < 3; a++) {
+        if (w[a] > 0.0) {
+            vec3 axis = vec3(0.0);
+            axis[a] = sign(n[a]);
+            vec3 f = emitter_phi(emitter, p, axis);
+            cosine += w[a] * dot(axis, f);
+            phi += w[a] * f;
+        }
+    }
+    if (cosine <= 0.0) {
+        return vec3(0.0);
+    }
+    vec3 dir = normalize(phi);
+    float cos_plane = max(-dot(emitter.plane.xyz, dir), 1e-3);
+    vec3 start = p + n * (2.0 * vct.origin.w);
+    float end = (dot(emitter.plane.xyz, start) - emitter.plane.w - 1.5 * vct.origin.w) / cos_plane;
+    return emitter.radiance.rgb * cosine * voxel_visibility(p, n, dir, end);
 }
 
 void main() {
@@ -182,6 +235,10 @@ void main() {
     for (uint i = 0u; i < frame.light_count; i++) {
         front += voxel_irradiance(lights[i], p, n);
         back += voxel_irradiance(lights[i], p, -n);
+    }
+    for (uint i = 0u; i < vct.emitter_count; i++) {
+        front += voxel_emitter_irradiance(vct_emitters[i], p, n);
+        back += voxel_emitter_irradiance(vct_emitters[i], p, -n);
     }
     bool back_lit = dot(back, vec3(1.0)) > dot(front, vec3(1.0)) && all(equal(emission, vec3(0.0)));
     vec3 e = len > 0.2 ? (back_lit ? back : front) : front + back;

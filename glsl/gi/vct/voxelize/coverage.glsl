@@ -9,6 +9,10 @@
 #include "common/mesh_push.glsl"
 #include "gi/vct/voxels.glsl"
 
+layout(set = SET_GI, binding = BINDING_VCT_SAMPLED_MATERIALS, std430) readonly buffer SampledMaterialBlock {
+    uint vct_sampled_materials[];
+};
+
 ivec3 unswizzle(ivec3 s, uint axis) {
     return axis == 0u ? s.zxy : (axis == 1u ? s.yzx : s.xyz);
 }
@@ -26,7 +30,10 @@ void cover_pixel(vec2 pixel, vec3 normal, vec2 uv, vec4 bounds, uint axis, vec3 
     }
     vec3 albedo = material_albedo(m, uv);
     vec3 n = normalize(normal);
-    vec3 emission = clamp(material_emission(m, uv) / max(vct.emission_range, 1e-6), 0.0, 1.0);
+    // The sampled emitters' light reaches the surfaces by sampling (gi/vct/emitters.glsl):
+    // in the voxels their emission would be gathered a second time.
+    bool sampled = ((vct_sampled_materials[draw.material / 32u] >> (draw.material % 32u)) & 1u) != 0u;
+    vec3 emission = sampled ? vec3(0.0) : clamp(material_emission(m, uv) / max(vct.emission_range, 1e-6), 0.0, 1.0);
 
     // The triangle's depth over this pixel's footprint: a slope up to 1 (dominant axis)
     // spans up to two voxels, and every one of them is covered.

@@ -165,6 +165,7 @@ impl VoxelStore for Dense {
         DebugView::VoxelAlbedo,
         DebugView::VoxelNormal,
         DebugView::VoxelRadiance,
+        DebugView::EmitterLight,
     ];
 
     fn bindings() -> Vec<Binding> {

@@ -144,6 +144,7 @@ impl VoxelStore for Octree {
         DebugView::VoxelAlbedo,
         DebugView::VoxelNormal,
         DebugView::VoxelRadiance,
+        DebugView::EmitterLight,
         DebugView::OctreeNodes,
     ];
 
