@@ -4,9 +4,9 @@
 // solid angle the emitter covers above the surface's horizon, is Lambert's sum over the
 // edges of the polygon clipped to that hemisphere (Arvo 1994): 1/2 of the sum of each
 // edge's angle times the unit normal of the plane through it and the surface point.
-// Phi also points where the light comes from, and its length is about the solid angle
-// (exactly for a small emitter): the axis and size of the one cone whose visibility
-// stands for the emitter's.
+// Phi also points where the light comes from (the axis of the cone whose visibility
+// stands for the emitter's), and its length is about the solid angle the emitter covers
+// (exactly for a small one).
 #ifndef EMITTERS_GLSL
 #define EMITTERS_GLSL
 #include "gi/vct/voxels.glsl"

@@ -22,7 +22,7 @@ layout(set = SET_SCREEN, binding = BINDING_SCREEN_SPECULAR, rgba16f) uniform wri
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_TRANSMITTED, rgba16f) uniform writeonly image2D transmitted;
 
 // Irradiance at the surface point p (normal n) from the sampled emitters, each shadowed by
-// a cone from `origin` along its phi, of the solid angle |phi|.
+// a soft-shadow cone from `origin` along its phi.
 vec3 sampled_emitter_light(vec3 p, vec3 origin, vec3 n) {
     vec3 e = vec3(0.0);
     for (uint i = 0u; i < vct.emitter_count; i++) {
@@ -30,9 +30,7 @@ vec3 sampled_emitter_light(vec3 p, vec3 origin, vec3 n) {
         vec3 phi = emitter_phi(emitter, p, n);
         float cosine = dot(n, phi);
         if (cosine > 0.0) {
-            float solid = length(phi);
-            e += emitter.radiance.rgb * cosine
-               * emitter_visibility(origin, p, n, phi / solid, emitter_cone_tan(solid), emitter.plane);
+            e += emitter.radiance.rgb * cosine * emitter_visibility(origin, p, n, normalize(phi), emitter.plane);
         }
     }
     return e;
@@ -57,7 +55,7 @@ float disc_overlap(float a, float b, float d) {
 // of the cone that a disc of its solid angle |phi| about phi's direction (phi over the
 // hemisphere about dir) covers of the cone's disc, both taken flat across dir (exact in
 // the limits of an emitter filling the cone or missing it); times its visibility along
-// the cone, no wider than the emitter.
+// the cone.
 vec3 sampled_emitter_radiance(vec3 p, vec3 origin, vec3 side, vec3 dir, float tan_half) {
     float cone = atan(tan_half);
     vec3 radiance = vec3(0.0);
@@ -71,8 +69,7 @@ vec3 sampled_emitter_radiance(vec3 p, vec3 origin, vec3 side, vec3 dir, float ta
         float apart = acos(clamp(dot(dir, phi / solid), -1.0, 1.0));
         float share = disc_overlap(sqrt(solid / PI), cone, apart) / (PI * cone * cone);
         if (share > 0.0) {
-            float tan_visible = min(tan_half, emitter_cone_tan(solid));
-            radiance += emitter.radiance.rgb * share * emitter_visibility(origin, p, side, dir, tan_visible, emitter.plane);
+            radiance += emitter.radiance.rgb * share * emitter_visibility(origin, p, side, dir, emitter.plane);
         }
     }
     return radiance;
