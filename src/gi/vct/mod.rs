@@ -389,7 +389,6 @@ impl<S: VoxelStore> ConeTracing<S> {
             only_cone: cones.only_cone.unwrap_or(u32::MAX),
             cosine_cones: u32::from(cones.cosine_cones),
             emitter_count: sampled.emitters.len() as u32,
-            ..Default::default()
         };
         let uniforms = Buffer::with_data(
             ctx,
