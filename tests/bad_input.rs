@@ -181,6 +181,15 @@ fn bad_gi_settings_in_scene_file() {
         &["render", &scene],
         &["diffuse_cones", "between 1 and 16", "40"],
     );
+    let scene = write(
+        &dir,
+        "emitters.toml",
+        "[[mesh]]\npath = \"t.obj\"\n[gi]\nsampled_emitters = 2000\n",
+    );
+    assert_fails_naming(
+        &["render", &scene],
+        &["sampled_emitters", "at most 1024", "2000"],
+    );
 }
 
 #[test]
@@ -191,6 +200,10 @@ fn voxel_options_without_voxels() {
     assert_fails_naming(
         &["render", "--gi", "off", "--debug-view", "ao"],
         &["--debug-view", "--gi dense"],
+    );
+    assert_fails_naming(
+        &["render", "--gi", "off", "--sampled-emitters", "4"],
+        &["--sampled-emitters", "--gi dense"],
     );
 }
 

@@ -5,11 +5,12 @@
 // Voxel cone tracing (Crassin et al. 2011) for one G-buffer pixel of each
 // indirect_scale² block: cosine-weighted diffuse cones over the normal's hemisphere are
 // marched front to back through the voxel radiance, the sky filling what they leave
-// unoccluded (alpha: ambient occlusion), and the sampled emitters' light is added; then the soft-shadow cones towards the lights,
-// the specular cone along the reflected view ray and, on transmissive surfaces, the
-// refraction cone. The upsample pass spreads the results to every pixel. Every cone is
-// traced here: a cone march compiled into the full-resolution upsample pass made it
-// twice as slow on lavapipe even where it never ran.
+// unoccluded (alpha: ambient occlusion), and the sampled emitters' light is added; then
+// the soft-shadow cones towards the lights, the specular cone along the reflected view
+// ray and, on transmissive surfaces, the refraction cone (each with the sampled
+// emitters' share of it). The upsample pass spreads the results to every pixel. Every
+// cone is traced here: a cone march compiled into the full-resolution upsample pass
+// made it twice as slow on lavapipe even where it never ran.
 #include "common/direct_light.glsl"
 #include "gi/vct/cones.glsl"
 #include "gi/vct/emitters.glsl"
