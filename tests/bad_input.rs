@@ -157,39 +157,36 @@ fn no_vulkan_driver() {
 fn bad_gi_settings_in_scene_file() {
     let dir = temp_dir("bad_gi_settings");
     write(&dir, "t.obj", TRIANGLE);
-    let scene = write(
-        &dir,
-        "scene.toml",
-        "[[mesh]]\npath = \"t.obj\"\n[gi]\nvoxels = 48\n",
-    );
-    assert_fails_naming(&["render", &scene], &["voxels", "power of two", "48"]);
-    let scene = write(
-        &dir,
-        "typo.toml",
-        "[[mesh]]\npath = \"t.obj\"\n[gi]\nvoxel = 64\n",
-    );
-    assert_fails_naming(
-        &["render", &scene],
-        &["typo.toml", "unknown field", "voxel"],
-    );
-    let scene = write(
-        &dir,
-        "cones.toml",
-        "[[mesh]]\npath = \"t.obj\"\n[gi]\ndiffuse_cones = 40\n",
-    );
-    assert_fails_naming(
-        &["render", &scene],
-        &["diffuse_cones", "between 1 and 16", "40"],
-    );
-    let scene = write(
-        &dir,
-        "emitters.toml",
-        "[[mesh]]\npath = \"t.obj\"\n[gi]\nsampled_emitters = 2000\n",
-    );
-    assert_fails_naming(
-        &["render", &scene],
-        &["sampled_emitters", "at most 1024", "2000"],
-    );
+    let cases: [(&str, &str, &[&str]); 4] = [
+        (
+            "scene.toml",
+            "voxels = 48",
+            &["voxels", "power of two", "48"],
+        ),
+        (
+            "typo.toml",
+            "voxel = 64",
+            &["typo.toml", "unknown field", "voxel"],
+        ),
+        (
+            "cones.toml",
+            "diffuse_cones = 40",
+            &["diffuse_cones", "between 1 and 16", "40"],
+        ),
+        (
+            "emitters.toml",
+            "sampled_emitters = 2000",
+            &["sampled_emitters", "at most 1024", "2000"],
+        ),
+    ];
+    for (name, setting, needles) in cases {
+        let scene = write(
+            &dir,
+            name,
+            &format!("[[mesh]]\npath = \"t.obj\"\n[gi]\n{setting}\n"),
+        );
+        assert_fails_naming(&["render", &scene], needles);
+    }
 }
 
 #[test]
