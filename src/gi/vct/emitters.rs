@@ -118,7 +118,8 @@ pub fn sampled_emitters(scene: &Scene, max_triangles: u32) -> SampledEmitters {
         }
     }
     log::info!(
-        "the cone tracer samples {} emitters ({count} triangles) instead of gathering their light",
+        "the cone tracer samples the emitters' light instead of gathering it: {} planar \
+         pieces, {count} triangles",
         out.emitters.len()
     );
     out
