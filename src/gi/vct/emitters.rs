@@ -18,11 +18,15 @@
 //! gather, as all emitters do with `--sampled-emitters 0`.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
+use anyhow::Result;
+use ash::vk;
 use glam::Vec3;
 
 use crate::gpu_layout::{VctEmitter, VctEmitterTriangle};
 use crate::scene::{Material, Scene};
+use crate::vk::{Buffer, Context};
 
 /// The sampled emitters, their triangles, and the material bits (`BINDING_VCT_SAMPLED_MATERIALS`).
 #[derive(Debug, Default)]
@@ -38,6 +42,30 @@ impl SampledEmitters {
         self.material_bits
             .get(m / 32)
             .is_some_and(|w| w & (1 << (m % 32)) != 0)
+    }
+
+    /// The storage buffers of `BINDING_VCT_EMITTERS`, `BINDING_VCT_EMITTER_TRIANGLES` and
+    /// `BINDING_VCT_SAMPLED_MATERIALS`, each of one unused entry where it would be empty.
+    pub fn upload(&self, ctx: &Arc<Context>) -> Result<[Buffer; 3]> {
+        fn storage<T: bytemuck::Pod + Default>(
+            ctx: &Arc<Context>,
+            name: &str,
+            entries: &[T],
+        ) -> Result<Buffer> {
+            let unused = [T::default()];
+            let entries = if entries.is_empty() { &unused } else { entries };
+            Buffer::with_data(
+                ctx,
+                name,
+                bytemuck::cast_slice(entries),
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )
+        }
+        Ok([
+            storage(ctx, "vct emitters", &self.emitters)?,
+            storage(ctx, "vct emitter triangles", &self.triangles)?,
+            storage(ctx, "vct sampled materials", &self.material_bits)?,
+        ])
     }
 }
 

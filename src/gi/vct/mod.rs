@@ -396,33 +396,7 @@ impl<S: VoxelStore> ConeTracing<S> {
             bytemuck::bytes_of(&uniforms),
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
-        // Never empty: a buffer of one unused entry where there is nothing to sample.
-        let emitter_buffer = |name: &str, bytes: &[u8], entry: usize| {
-            let zeros = vec![0u8; entry];
-            Buffer::with_data(
-                ctx,
-                name,
-                if bytes.is_empty() { &zeros } else { bytes },
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-            )
-        };
-        let emitter_buffers = [
-            emitter_buffer(
-                "vct emitters",
-                bytemuck::cast_slice(&sampled.emitters),
-                std::mem::size_of::<layout::VctEmitter>(),
-            )?,
-            emitter_buffer(
-                "vct emitter triangles",
-                bytemuck::cast_slice(&sampled.triangles),
-                std::mem::size_of::<layout::VctEmitterTriangle>(),
-            )?,
-            emitter_buffer(
-                "vct sampled materials",
-                bytemuck::cast_slice(&sampled.material_bits),
-                4,
-            )?,
-        ];
+        let emitter_buffers = sampled.upload(ctx)?;
         let storage = vk::DescriptorType::STORAGE_BUFFER;
         SetWriter::new(ctx, set)
             .buffer(
