@@ -552,6 +552,14 @@ gpu_layout! {
         uint cosine_cones,
         /// Entries of `BINDING_VCT_EMITTERS`: the emitters whose light the cones' passes sample.
         uint emitter_count,
+        /// 1: the cones read the directional volumes snapped along each volume's axis, in cells half their diameter, the ring cones clear of their own surface, the cone along the normal as four sub-cones (`--snapped-cones`); 0: trilinear lookups in cells as wide as the cone.
+        uint snapped_cones,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+        /// Unused.
+        uint pad2,
     }
 
     /// A planar group of emissive triangles whose light voxel cone tracing samples: their exact unoccluded irradiance, times one soft-shadow cone's visibility (`glsl/gi/vct/emitters.glsl`).

@@ -462,11 +462,13 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             }
             let mut wide = vct.cones.wide_steps_by_level;
             let mut cosine = vct.cones.cosine_cones;
+            let mut snapped = vct.cones.snapped_cones;
             let mut accumulate = vct.cones.accumulate_bounces;
             let mut full_update = vct.full_update;
             let mut voxelizer = vct.voxelizer;
             settle(ui.checkbox(&mut wide, "wide steps by level"));
             settle(ui.checkbox(&mut cosine, "cosine-weighted cones"));
+            settle(ui.checkbox(&mut snapped, "snapped cones"));
             settle(ui.checkbox(&mut accumulate, "accumulate bounces over frames"));
             settle(ui.checkbox(&mut full_update, "voxelize everything every frame"));
             egui::ComboBox::from_label("voxelizer")
@@ -478,6 +480,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                 });
             args.wide_steps_by_level = wide;
             args.cosine_cones = cosine;
+            args.snapped_cones = snapped;
             args.no_accumulate = !accumulate;
             args.full_update = full_update;
             if voxelizer != vct.voxelizer {

@@ -55,6 +55,7 @@
 //! shadow_step_factor = 0.5       # --shadow-step-factor
 //! wide_steps_by_level = false    # --wide-steps-by-level
 //! cosine_cones = false           # --cosine-cones
+//! snapped_cones = false          # --snapped-cones
 //! bounces = 8                    # --bounces
 //! indirect_scale = 2             # --indirect-scale (default: by image height)
 //! shadow_cones = false           # --shadow-cones

@@ -205,6 +205,7 @@ pub struct GiOverrides {
     pub shadow_step_factor: Option<f32>,
     pub wide_steps_by_level: Option<bool>,
     pub cosine_cones: Option<bool>,
+    pub snapped_cones: Option<bool>,
     pub bounces: Option<u32>,
     pub indirect_scale: Option<u32>,
     pub shadow_cones: Option<bool>,

@@ -29,11 +29,39 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
     return textureLod(voxel_directional, vec3(x, uvw.yz), l);
 }
 
-// The three directional volumes facing a cone travelling along `dir`.
+// The directional volume d at `uvw` and whole mip `level`, read at the centre of the cell
+// that holds uvw along d's axis and trilinearly across it (`--snapped-cones`).
+vec4 fetch_snapped(int d, vec3 uvw, float level) {
+    int axis = d / 2;
+    float cells = float(vct.resolution >> (int(level) + 1u));
+    uvw[axis] = (min(floor(clamp(uvw[axis], 0.0, 1.0) * cells), cells - 1.0) + 0.5) / cells;
+    float x = (float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / 6.0;
+    return textureLod(voxel_directional, vec3(x, uvw.yz), level);
+}
+
+// The three directional volumes facing a cone travelling along `dir`. With
+// `--snapped-cones` each is read snapped along its own axis (SNAPPED_CONES in cones.glsl),
+// one fetch per level of the two a fractional level blends.
 void sample_facing(vec3 uvw, vec3 dir, float level, out vec4 sx, out vec4 sy, out vec4 sz) {
-    sx = sample_directional(dir.x >= 0.0 ? 0 : 1, uvw, level);
-    sy = sample_directional(dir.y >= 0.0 ? 2 : 3, uvw, level);
-    sz = sample_directional(dir.z >= 0.0 ? 4 : 5, uvw, level);
+    ivec3 d = ivec3(dir.x >= 0.0 ? 0 : 1, dir.y >= 0.0 ? 2 : 3, dir.z >= 0.0 ? 4 : 5);
+    if (vct.snapped_cones != 0u) {
+        float l = clamp(level, 0.0, float(vct.directional_levels) - 1.0);
+        float fine = floor(l);
+        float t = l - fine;
+        sx = fetch_snapped(d.x, uvw, fine);
+        sy = fetch_snapped(d.y, uvw, fine);
+        sz = fetch_snapped(d.z, uvw, fine);
+        if (t > 0.0) {
+            float coarse = fine + 1.0;
+            sx = mix(sx, fetch_snapped(d.x, uvw, coarse), t);
+            sy = mix(sy, fetch_snapped(d.y, uvw, coarse), t);
+            sz = mix(sz, fetch_snapped(d.z, uvw, coarse), t);
+        }
+        return;
+    }
+    sx = sample_directional(d.x, uvw, level);
+    sy = sample_directional(d.y, uvw, level);
+    sz = sample_directional(d.z, uvw, level);
 }
 
 #else
@@ -135,6 +163,20 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
     return mix(near, far, t);
 }
 
+// Directional radiance d of an interior brick at a located place at `level`, with
+// `--snapped-cones` moved along d's axis to the centre of the voxel of that level that
+// holds `uvw`, as the dense grid's fetch_snapped: the brick's border holds that voxel
+// where it lies in a neighbouring node.
+vec4 read_interior_facing(BrickSample s, int d, vec3 uvw, uint level) {
+    if (vct.snapped_cones != 0u) {
+        int axis = d / 2;
+        float voxels = float(2u << level);
+        float q = clamp(uvw[axis], 0.0, 1.0) * voxels;
+        s.local[axis] += min(floor(q), voxels - 1.0) + 0.5 - q;
+    }
+    return read_interior(s, d);
+}
+
 void sample_facing(vec3 uvw, vec3 dir, float level, out vec4 sx, out vec4 sy, out vec4 sz) {
     uint fine;
     uint coarse;
@@ -146,18 +188,18 @@ void sample_facing(vec3 uvw, vec3 dir, float level, out vec4 sx, out vec4 sy, ou
     sz = vec4(0.0);
     BrickSample s;
     if (locate(uvw, fine, s)) {
-        sx = read_interior(s, d.x);
-        sy = read_interior(s, d.y);
-        sz = read_interior(s, d.z);
+        sx = read_interior_facing(s, d.x, uvw, fine);
+        sy = read_interior_facing(s, d.y, uvw, fine);
+        sz = read_interior_facing(s, d.z, uvw, fine);
     }
     if (t > 0.0) {
         vec4 cx = vec4(0.0);
         vec4 cy = vec4(0.0);
         vec4 cz = vec4(0.0);
         if (locate(uvw, coarse, s)) {
-            cx = read_interior(s, d.x);
-            cy = read_interior(s, d.y);
-            cz = read_interior(s, d.z);
+            cx = read_interior_facing(s, d.x, uvw, coarse);
+            cy = read_interior_facing(s, d.y, uvw, coarse);
+            cz = read_interior_facing(s, d.z, uvw, coarse);
         }
         sx = mix(sx, cx, t);
         sy = mix(sy, cy, t);

@@ -47,6 +47,14 @@ pub struct VctArgs {
     /// ring.
     #[arg(long)]
     pub cosine_cones: bool,
+    /// Read each directional volume snapped to its cell along the volume's axis (the cell
+    /// whole along the way the cone crosses it, trilinear across it), in cells half the
+    /// cone's diameter; keep the ring cones' lookups clear of their own surface (cells at
+    /// most a third of the height above it, samples at least 1.5 coarser cells above
+    /// it); trace the cone along the normal as four sub-cones. Off: the trilinear lookups
+    /// in cells as wide as the cone, tuned at 64³.
+    #[arg(long)]
+    pub snapped_cones: bool,
     /// Diffuse cones per gather, 1 to 16: one along the normal, the rest in a ring at 57.5
     /// degrees, each traced on screen as narrower sub-cones [default: 6].
     #[arg(long)]
@@ -106,6 +114,7 @@ impl VctArgs {
             (self.shadow_step_factor.is_some(), "--shadow-step-factor"),
             (self.wide_steps_by_level, "--wide-steps-by-level"),
             (self.cosine_cones, "--cosine-cones"),
+            (self.snapped_cones, "--snapped-cones"),
             (self.diffuse_cones.is_some(), "--diffuse-cones"),
             (self.indirect_scale.is_some(), "--indirect-scale"),
             (self.no_accumulate, "--no-accumulate"),
@@ -150,6 +159,7 @@ impl VctArgs {
             wide_steps_by_level: self.wide_steps_by_level
                 || scene.wide_steps_by_level.unwrap_or(d.wide_steps_by_level),
             cosine_cones: self.cosine_cones || scene.cosine_cones.unwrap_or(d.cosine_cones),
+            snapped_cones: self.snapped_cones || scene.snapped_cones.unwrap_or(d.snapped_cones),
             accumulate_bounces: !self.no_accumulate,
             shadow_aperture_deg: self
                 .shadow_aperture

@@ -389,6 +389,10 @@ impl<S: VoxelStore> ConeTracing<S> {
             only_cone: cones.only_cone.unwrap_or(u32::MAX),
             cosine_cones: u32::from(cones.cosine_cones),
             emitter_count: sampled.emitters.len() as u32,
+            snapped_cones: u32::from(cones.snapped_cones),
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         };
         let uniforms = Buffer::with_data(
             ctx,

@@ -77,6 +77,12 @@ pub struct ConeSettings {
     /// share of the cosine-weighted hemisphere. Off by default: the plain quadrature's
     /// errors still balance the tracer's (BENCHMARKS.md, session 28).
     pub cosine_cones: bool,
+    /// The cones read the directional volumes snapped along each volume's axis
+    /// (`--snapped-cones`): whole cells along the axis, trilinear across it, cells half the
+    /// cone's diameter, the ring cones kept clear of their own surface and the cone along
+    /// the normal traced as four sub-cones. Off by default: better on large rooms and as
+    /// the voxels get finer, worse on the Cornell box at 64³ (BENCHMARKS.md, session 30).
+    pub snapped_cones: bool,
     /// Light bounces between voxels: 1 is direct light on the voxels only.
     pub bounces: u32,
     /// Indirect light is traced on one pixel of each `indirect_scale`² block and
@@ -187,6 +193,7 @@ impl Default for ConeSettings {
             shadow_step_factor: 0.5,
             wide_steps_by_level: false,
             cosine_cones: false,
+            snapped_cones: false,
             bounces: 8,
             indirect_scale: None,
             accumulate_bounces: true,
