@@ -86,7 +86,7 @@ vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lo
     vec3 x = origin + dir * dist;
     float height = dot(x - surface, n);
     diameter = max(voxel, 2.0 * tan_half * dist);
-    if (vct.snapped_cones != 0u) {
+    if (SNAPPED_CONES) {
         bool clear = dot(dir, n) < 0.9;
         float cell = clear ? min(0.5 * diameter, height / 3.0) : 0.5 * diameter;
         lod = max(log2(max(cell, voxel) / voxel), min_lod);
@@ -161,7 +161,7 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surfa
         float step_length = (vct.wide_steps_by_level != 0u && min_lod >= 1.0) ? max(dist, diameter * step_factor)
                                                                               : diameter * step_factor;
         // Snapped lookups take a crossed cell whole: no step may skip one.
-        if (vct.snapped_cones != 0u) {
+        if (SNAPPED_CONES) {
             step_length = min(step_length, footprint);
         }
         float next_lod;
@@ -357,7 +357,7 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
     // of the walls' radiance at 64³ and 0.67 at 256³; as sub-cones 0.97 and 0.997.
     vec4 centre = vec4(0.0);
     if (only <= 0) {
-        centre = split_ring && vct.snapped_cones != 0u
+        centre = split_ring && SNAPPED_CONES
                      ? trace_ring_cone(origin, n, 4, min_lod, surface, n, step_factor, ao_volume)
                      : trace_cone(origin, n, vct.diffuse_tan_half, min_lod, surface, n, ao_volume, step_factor);
     }

@@ -11,6 +11,11 @@
 layout(set = SET_GI, binding = BINDING_VCT_RADIANCE_SAMPLED) uniform sampler3D voxel_radiance;
 layout(set = SET_GI, binding = BINDING_VCT_DIRECTIONAL) uniform sampler3D voxel_directional;
 
+// `--snapped-cones` (SNAPPED_CONES in cones.glsl), fixed when the pipeline is made: as a
+// uniform tested in branches, lavapipe inlined it and compiled the passes anew at every
+// bind (see SPEC_SNAPPED_CONES).
+layout(constant_id = SPEC_SNAPPED_CONES) const bool SNAPPED_CONES = false;
+
 #ifndef OCTREE
 
 // The base level at `uvw`.
@@ -44,7 +49,7 @@ vec4 fetch_snapped(int d, vec3 uvw, float level) {
 // one fetch per level of the two a fractional level blends.
 void sample_facing(vec3 uvw, vec3 dir, float level, out vec4 sx, out vec4 sy, out vec4 sz) {
     ivec3 d = ivec3(dir.x >= 0.0 ? 0 : 1, dir.y >= 0.0 ? 2 : 3, dir.z >= 0.0 ? 4 : 5);
-    if (vct.snapped_cones != 0u) {
+    if (SNAPPED_CONES) {
         float l = clamp(level, 0.0, float(vct.directional_levels) - 1.0);
         float fine = floor(l);
         float t = l - fine;
@@ -168,7 +173,7 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
 // holds `uvw`, as the dense grid's fetch_snapped: the brick's border holds that voxel
 // where it lies in a neighbouring node.
 vec4 read_interior_facing(BrickSample s, int d, vec3 uvw, uint level) {
-    if (vct.snapped_cones != 0u) {
+    if (SNAPPED_CONES) {
         int axis = d / 2;
         float voxels = float(2u << level);
         float q = clamp(uvw[axis], 0.0, 1.0) * voxels;

@@ -243,22 +243,25 @@ pub(crate) fn bind_cone_samples<'a>(
 
 /// What every pipeline of voxel cone tracing is made with: the layouts of sets 0 to 3,
 /// and the specialization constants (`SPEC_OCTREE_DEPTH`, which the dense grid's shaders
-/// do not declare and so ignore).
+/// do not declare and so ignore, and `SPEC_SNAPPED_CONES`).
 #[derive(Clone, Copy)]
 pub struct PipelineBase {
     pub sets: [vk::DescriptorSetLayout; 4],
-    constants: [u32; 1],
+    constants: [u32; 2],
 }
 
 impl PipelineBase {
-    /// For the cone tracer over `grid`, whose store's set 3 has the layout `store_set`.
+    /// For the cone tracer over `grid` with `cones`, whose store's set 3 has the layout
+    /// `store_set`.
     fn new(
         set_layouts: &[vk::DescriptorSetLayout; 3],
         store_set: vk::DescriptorSetLayout,
         grid: &Grid,
+        cones: &ConeSettings,
     ) -> Self {
-        let mut constants = [0; 1];
+        let mut constants = [0; 2];
         constants[layout::SPEC_OCTREE_DEPTH as usize] = grid.resolution.ilog2();
+        constants[layout::SPEC_SNAPPED_CONES as usize] = u32::from(cones.snapped_cones);
         Self {
             sets: [set_layouts[0], set_layouts[1], set_layouts[2], store_set],
             constants,
@@ -359,7 +362,7 @@ impl<S: VoxelStore> ConeTracing<S> {
             // and filtering towards a border would thin every wall there.
             &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::CLAMP_TO_EDGE),
         )?;
-        let base = PipelineBase::new(&set_layouts, sets.layout, &grid);
+        let base = PipelineBase::new(&set_layouts, sets.layout, &grid, &cones);
         let store = S::new(
             ctx,
             scene,
@@ -389,10 +392,6 @@ impl<S: VoxelStore> ConeTracing<S> {
             only_cone: cones.only_cone.unwrap_or(u32::MAX),
             cosine_cones: u32::from(cones.cosine_cones),
             emitter_count: sampled.emitters.len() as u32,
-            snapped_cones: u32::from(cones.snapped_cones),
-            pad0: 0,
-            pad1: 0,
-            pad2: 0,
         };
         let uniforms = Buffer::with_data(
             ctx,
