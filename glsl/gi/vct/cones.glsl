@@ -353,7 +353,7 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
     // With `--snapped-cones` the screen's cone along the normal is traced as four
     // sub-cones too: whole, its lookups reach past a closed room's far wall into the
     // empty space beyond, where its outer rays would meet the walls beside it (edge-on to
-    // the cone). In a closed emissive box whose walls lie inside the grid it gathered 0.85
+    // the cone). In a closed emissive box whose walls lie inside the grid it gathered 0.84
     // of the walls' radiance at 64³ and 0.67 at 256³; as sub-cones 0.97 and 0.997.
     vec4 centre = vec4(0.0);
     if (only <= 0) {
