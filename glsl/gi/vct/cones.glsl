@@ -350,14 +350,15 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
     int parts = split_ring ? (ring <= 5 ? 4 : (ring <= 10 ? 2 : 1)) : 1;
     // One call site per kind of cone, also for `only`: each is inlined, and lavapipe ran
     // the gather 2 % slower with a second copy of each for the single cone.
-    // With `--snapped-cones` the screen's cone along the normal is traced as four
-    // sub-cones too: whole, its lookups reach past a closed room's far wall into the
-    // empty space beyond, where its outer rays would meet the walls beside it (edge-on to
-    // the cone). In a closed emissive box whose walls lie inside the grid it gathered 0.84
-    // of the walls' radiance at 64³ and 0.67 at 256³; as sub-cones 0.97 and 0.997.
+    // With `--snapped-cones` the cone along the normal is traced as four sub-cones, in
+    // the screen's gather and in the voxels' bounce alike: whole, its lookups reach past
+    // a closed room's far wall into the empty space beyond, where its outer rays would
+    // meet the walls beside it (edge-on to the cone). In a closed emissive box whose
+    // walls lie inside the grid it gathered 0.84 of the walls' radiance at 64³ and 0.67
+    // at 256³; as sub-cones 0.97 and 0.997.
     vec4 centre = vec4(0.0);
     if (only <= 0) {
-        centre = split_ring && SNAPPED_CONES
+        centre = SNAPPED_CONES
                      ? trace_ring_cone(origin, n, 4, min_lod, surface, n, step_factor, ao_volume)
                      : trace_cone(origin, n, vct.diffuse_tan_half, min_lod, surface, n, ao_volume, step_factor);
     }

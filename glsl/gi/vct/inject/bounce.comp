@@ -14,7 +14,12 @@ layout(set = SET_GI, binding = BINDING_VCT_NORMAL, r32ui) uniform readonly uimag
 layout(set = SET_GI, binding = BINDING_VCT_DIRECT, rgba16f) uniform readonly image3D voxel_direct;
 
 // Cones per voxel gather, whatever --diffuse-cones asks of the screen: six cover the
-// hemisphere well enough for light that is filtered again before anyone sees it.
+// hemisphere well enough for light that is filtered again before anyone sees it. The
+// ring's cones stay whole; with `--snapped-cones` the cone along the normal is four
+// sub-cones, as the screen's is (cones.glsl). On `conference_main` that raised every
+// bounce after the first from 0.994 / 0.750 of the path tracer's at 64³ / 256³ to
+// 1.082 / 0.907; splitting the ring as well, as the screen does, gathered less at 2.7
+// times the cones (1.054 / 0.856; BENCHMARKS.md, session 31).
 const int BOUNCE_CONES = 6;
 
 void main() {
