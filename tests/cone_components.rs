@@ -901,6 +901,66 @@ fn first_bounce_holds_its_total_as_the_voxels_get_finer() {
     }
 }
 
+/// Every bounce over the first, as `bounces_over_the_first_match_the_path_tracer`
+/// measures it on the Cornell box, on a reference scene `name` at 64³ and 256³ with
+/// `--snapped-cones`: ours (all bounces over `--bounces 1`, each less `--gi off`) over
+/// the path tracer's (the reference over `--max-depth 3`, each less `--max-depth 2`).
+fn bounces_over_the_first_with_snapped_cones(name: &str) -> Vec<f64> {
+    let scene = shared().join(format!("reference/{name}.scene.json"));
+    let dir = temp_dir(&format!("components_bounces_{name}"));
+    let path = |f: &str| dir.join(f);
+    for depth in ["2", "3"] {
+        render_path(
+            &scene,
+            &["--size", "256x256", "--spp", "64", "--max-depth", depth],
+            &path(&format!("path_{depth}.exr")),
+        );
+    }
+    render_256(&scene, &["--gi", "off"], &path("off.exr"));
+    let total = |v: Vec<f64>| v.iter().sum::<f64>();
+    let exact = total(block_indirect(
+        &shared().join(format!("reference/{name}.exr")),
+        &path("path_2.exr"),
+    )) / total(block_indirect(&path("path_3.exr"), &path("path_2.exr")));
+    let mut ratios = Vec::new();
+    for voxels in [64, 256] {
+        let one = path(&format!("one_{voxels}.exr"));
+        let all = path(&format!("all_{voxels}.exr"));
+        dense(&scene, voxels, &["--snapped-cones", "--bounces", "1"], &one);
+        dense(&scene, voxels, &["--snapped-cones"], &all);
+        let ours = total(block_indirect(&all, &path("off.exr")))
+            / total(block_indirect(&one, &path("off.exr")));
+        ratios.push(ours / exact);
+    }
+    eprintln!(
+        "{name}: every bounce over the first, over the path tracer's, 64³ and 256³: {ratios:.3?}"
+    );
+    ratios
+}
+
+/// On `conference_main`, within 5 % at 64³ and at 256³ (measured 0.980 and 0.969; with
+/// the voxels' cone along the normal whole, as before session 31, 0.927 and 0.861).
+#[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn conference_bounces_over_the_first_match_the_path_tracer_with_snapped_cones() {
+    for r in bounces_over_the_first_with_snapped_cones("conference_main") {
+        assert!((r - 1.0).abs() <= 0.05, "{r}");
+    }
+}
+
+/// On `sibenik_main`, the same.
+#[test]
+#[cfg_attr(
+    voxcone_shared,
+    ignore = "issue 20: 0.982 of the path tracer's at 64³, 0.944 at 256³ (session 31)"
+)]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn sibenik_bounces_over_the_first_match_the_path_tracer_with_snapped_cones() {
+    for r in bounces_over_the_first_with_snapped_cones("sibenik_main") {
+        assert!((r - 1.0).abs() <= 0.05, "{r}");
+    }
+}
+
 /// `conference_main`'s point light, as a scene file in `dir` with the `[camera]` table
 /// `camera`.
 fn conference_with_camera(dir: &Path, camera: &str) -> PathBuf {
