@@ -23,15 +23,19 @@ vec4 sample_base(vec3 uvw) {
     return textureLod(voxel_radiance, uvw, 0.0);
 }
 
-// The directional volume d (+X -X +Y -Y +Z -Z) at `uvw` and mip `level`, one trilinear
-// fetch blending two levels. The six sit side by side along x, each in the middle of a
-// slot twice its width whose margins repeat its edge voxels (filter.comp), so that
-// filtering clamps at the cube's faces as at the texture's and never mixes two
-// directions, at every level alike.
+// Where `uvw` of the directional volume d (+X -X +Y -Y +Z -Z) lies in their texture. The
+// six sit side by side along x, each in the middle of a slot twice its width whose
+// margins repeat its edge voxels (filter.comp), so that filtering clamps at the cube's
+// faces as at the texture's and never mixes two directions, at every level alike.
+vec3 directional_slot(int d, vec3 uvw) {
+    return vec3((float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / 6.0, uvw.yz);
+}
+
+// The directional volume d at `uvw` and mip `level`, one trilinear fetch blending two
+// levels.
 vec4 sample_directional(int d, vec3 uvw, float level) {
     float l = clamp(level, 0.0, float(vct.directional_levels) - 1.0);
-    float x = (float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / 6.0;
-    return textureLod(voxel_directional, vec3(x, uvw.yz), l);
+    return textureLod(voxel_directional, directional_slot(d, uvw), l);
 }
 
 // The directional volume d at `uvw` and whole mip `level`, read at the centre of the cell
@@ -40,8 +44,7 @@ vec4 fetch_snapped(int d, vec3 uvw, float level) {
     int axis = d / 2;
     float cells = float(vct.resolution >> (int(level) + 1u));
     uvw[axis] = (min(floor(clamp(uvw[axis], 0.0, 1.0) * cells), cells - 1.0) + 0.5) / cells;
-    float x = (float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / 6.0;
-    return textureLod(voxel_directional, vec3(x, uvw.yz), level);
+    return textureLod(voxel_directional, directional_slot(d, uvw), level);
 }
 
 // The three directional volumes facing a cone travelling along `dir`. With
