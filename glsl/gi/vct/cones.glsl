@@ -73,13 +73,19 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
 // one beside it: a wall one voxel thick passed 31 % of the light at 64³, and a closed
 // room lost what its walls let through to the empty space beyond them. Across the cone
 // the lookup stays linear: there interpolated opacity is the covered share. The cells are
-// half the diameter, so that the tent across them is as wide as the cone. A cone more
+// those of the whole level at most half the diameter (no blend with the next level), so
+// that the tent across them reaches no further than the cone: a coarser cell holding the
+// end of a wall that the cone meets face-on (a room's far wall where it meets a side wall)
+// is only partly covered, the rest lying beyond the side wall where none of the cone's rays
+// go, and blended in by its centre's distance it let a tenth of the light out through
+// the far wall (a closed box inside the grid, the cone along the normal: 0.90 of the
+// walls' light at 256³, 0.99 with whole levels; BENCHMARKS.md, session 32). A cone more
 // than 26 degrees off the normal reads its own plane in the volumes it crosses edge-on,
 // and gathers its own light: its cells are at most a third of its height above the plane,
-// and it is lifted until it is 1.5 cells of the coarser level it blends above it, where no
-// lookup reaches the plane's cells (a cell of size c blends cells reaching 1.5 c from
-// the sample). The cone along the normal sees its plane only from behind, which the
-// facing weights hide (anisotropic.glsl), and keeps cells half its diameter.
+// and it is lifted until it is 1.5 cells above it, where no lookup reaches the plane's
+// cells (a cell of size c blends cells reaching 1.5 c from the sample). The cone along
+// the normal sees its plane only from behind, which the facing weights hide
+// (anisotropic.glsl).
 vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lod, vec3 surface, vec3 n,
                  out float lod, out float diameter, out float footprint) {
     float voxel = vct.origin.w;
@@ -89,9 +95,9 @@ vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lo
     if (SNAPPED_CONES) {
         bool clear = dot(dir, n) < 0.9;
         float cell = clear ? min(0.5 * diameter, height / 3.0) : 0.5 * diameter;
-        lod = max(log2(max(cell, voxel) / voxel), min_lod);
+        lod = max(floor(log2(max(cell, voxel) / voxel)), min_lod);
         footprint = voxel * exp2(lod);
-        float above = clear ? 1.5 * voxel * exp2(ceil(lod)) : 1.125 * footprint;
+        float above = (clear ? 1.5 : 1.125) * footprint;
         x += n * max(above - height, 0.0);
         return (x - vct.origin.xyz) / (voxel * float(vct.resolution));
     }
