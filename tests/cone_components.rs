@@ -241,8 +241,8 @@ fn furnace_inside_the_grid_within_two_percent_with_snapped_cones() {
 /// one's are black, and a white quad in the right room faces the left one. The light
 /// it gathers through a wall between them (two-sided, no thickness, inside one voxel
 /// at every resolution), as a share of what it gathers with the wall taken away.
-fn wall_leak(voxels: u32) -> f32 {
-    let dir = temp_dir(&format!("components_wall_{voxels}"));
+fn wall_leak(voxels: u32, extra: &[&str]) -> f32 {
+    let dir = temp_dir(&format!("components_wall_{voxels}_{}", extra.len()));
     write(
         &dir,
         "rooms.mtl",
@@ -315,12 +315,12 @@ fn wall_leak(voxels: u32) -> f32 {
              [[mesh]]\npath = \"rooms.obj\"\n",
         );
         let out = dir.join(format!("rooms_{with_wall}.exr"));
-        dense(&scene, voxels, &[], &out);
+        dense(&scene, voxels, extra, &out);
         gathered[i] = centre(&out);
     }
     let leak = gathered[1] / gathered[0];
     eprintln!(
-        "thin wall, {voxels}³: {:.4} without it, {:.4} through it: passes {leak:.4}",
+        "thin wall {extra:?}, {voxels}³: {:.4} without it, {:.4} through it: passes {leak:.4}",
         gathered[0], gathered[1]
     );
     leak
@@ -329,10 +329,23 @@ fn wall_leak(voxels: u32) -> f32 {
 #[test]
 #[ignore = "issue 20: the wall passes 0.136 of the light at 64³ (the lit room's walls are sampled emitters: their visibility cones leak; gathered through the voxels, 0.31)"]
 fn thin_wall_passes_little_light() {
-    let coarse = wall_leak(64);
+    let coarse = wall_leak(64, &[]);
     assert!(coarse <= 0.05, "64³: passes {coarse}");
-    let fine = wall_leak(128);
+    let fine = wall_leak(128, &[]);
     assert!(fine < coarse, "128³ passes {fine}, 64³ {coarse}");
+}
+
+/// With `--snapped-cones` the wall passes 0.0008, 0.0016 and 0.0011 of the light at 64³,
+/// 128³ and 256³ (0.122 at 64³ while the visibility cones read the base level
+/// trilinearly, before session 32). Both are at the floor that the opacity clamp sets
+/// (a sample of 0.9999 that counts half a footprint passes 1 %), so at 128³ the wall
+/// may pass as much as at 64³ or up to that floor.
+#[test]
+fn thin_wall_passes_little_light_with_snapped_cones() {
+    let coarse = wall_leak(64, &["--snapped-cones"]);
+    assert!(coarse <= 0.05, "64³: passes {coarse}");
+    let fine = wall_leak(128, &["--snapped-cones"]);
+    assert!(fine <= coarse.max(0.01), "128³ passes {fine}, 64³ {coarse}");
 }
 
 /// An image's channels summed over 32x32 blocks.

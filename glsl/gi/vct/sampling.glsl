@@ -23,6 +23,22 @@ vec4 sample_base(vec3 uvw) {
     return textureLod(voxel_radiance, uvw, 0.0);
 }
 
+// Along one axis, the centre of the cell, of `cells` across the grid, that holds the
+// texture coordinate `u`.
+float cell_centre(float u, float cells) {
+    return (min(floor(clamp(u, 0.0, 1.0) * cells), cells - 1.0) + 0.5) / cells;
+}
+
+// The base level at `uvw` read three times, each at the centre of the voxel that holds
+// uvw along one axis (sx along x, and so on) and trilinearly across it
+// (`--snapped-cones`).
+void sample_base_snapped(vec3 uvw, out vec4 sx, out vec4 sy, out vec4 sz) {
+    float cells = float(vct.resolution);
+    sx = textureLod(voxel_radiance, vec3(cell_centre(uvw.x, cells), uvw.yz), 0.0);
+    sy = textureLod(voxel_radiance, vec3(uvw.x, cell_centre(uvw.y, cells), uvw.z), 0.0);
+    sz = textureLod(voxel_radiance, vec3(uvw.xy, cell_centre(uvw.z, cells)), 0.0);
+}
+
 // Where `uvw` of the directional volume d (+X -X +Y -Y +Z -Z) lies in their texture. The
 // six sit side by side along x, each in the middle of a slot twice its width whose
 // margins repeat its edge voxels (filter.comp), so that filtering clamps at the cube's
@@ -42,8 +58,7 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
 // that holds uvw along d's axis and trilinearly across it (`--snapped-cones`).
 vec4 fetch_snapped(int d, vec3 uvw, float level) {
     int axis = d / 2;
-    float cells = float(vct.resolution >> (int(level) + 1u));
-    uvw[axis] = (min(floor(clamp(uvw[axis], 0.0, 1.0) * cells), cells - 1.0) + 0.5) / cells;
+    uvw[axis] = cell_centre(uvw[axis], float(vct.resolution >> (int(level) + 1u)));
     return textureLod(voxel_directional, directional_slot(d, uvw), level);
 }
 
@@ -147,6 +162,30 @@ vec4 sample_base(vec3 uvw) {
     return locate(uvw, octree_depth() - 1u, s) ? read_leaf(s) : vec4(0.0);
 }
 
+// A located place `s` at `level` moved along `axis` to the centre of the voxel of that
+// level that holds `uvw`, as the dense grid's cell_centre (`--snapped-cones`): the
+// brick's border holds that voxel where it lies in a neighbouring node.
+BrickSample snapped(BrickSample s, int axis, vec3 uvw, uint level) {
+    float voxels = float(2u << level);
+    float q = clamp(uvw[axis], 0.0, 1.0) * voxels;
+    s.local[axis] += min(floor(q), voxels - 1.0) + 0.5 - q;
+    return s;
+}
+
+void sample_base_snapped(vec3 uvw, out vec4 sx, out vec4 sy, out vec4 sz) {
+    uint level = octree_depth() - 1u;
+    BrickSample s;
+    if (!locate(uvw, level, s)) {
+        sx = vec4(0.0);
+        sy = vec4(0.0);
+        sz = vec4(0.0);
+        return;
+    }
+    sx = read_leaf(snapped(s, 0, uvw, level));
+    sy = read_leaf(snapped(s, 1, uvw, level));
+    sz = read_leaf(snapped(s, 2, uvw, level));
+}
+
 // Directional level `level` (0: voxels twice the leaves' size) is held by the interior
 // nodes at depth - 2 - level; a fractional level blends two (quadrilinear). The root's
 // bricks are the coarsest level (the dense chain goes one further, to a single voxel).
@@ -172,17 +211,9 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
 }
 
 // Directional radiance d of an interior brick at a located place at `level`, with
-// `--snapped-cones` moved along d's axis to the centre of the voxel of that level that
-// holds `uvw`, as the dense grid's fetch_snapped: the brick's border holds that voxel
-// where it lies in a neighbouring node.
+// `--snapped-cones` snapped along d's axis, as the dense grid's fetch_snapped.
 vec4 read_interior_facing(BrickSample s, int d, vec3 uvw, uint level) {
-    if (SNAPPED_CONES) {
-        int axis = d / 2;
-        float voxels = float(2u << level);
-        float q = clamp(uvw[axis], 0.0, 1.0) * voxels;
-        s.local[axis] += min(floor(q), voxels - 1.0) + 0.5 - q;
-    }
-    return read_interior(s, d);
+    return read_interior(SNAPPED_CONES ? snapped(s, d / 2, uvw, level) : s, d);
 }
 
 void sample_facing(vec3 uvw, vec3 dir, float level, out vec4 sx, out vec4 sy, out vec4 sz) {
