@@ -102,9 +102,13 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
 // the far wall (a closed box inside the grid, the cone along the normal: 0.90 of the
 // walls' light at 256³, 0.99 with whole levels; BENCHMARKS.md, session 32). A cone more
 // than 26 degrees off the normal reads its own plane in the volumes it crosses edge-on,
-// and gathers its own light: its cells are at most a third of its height above the plane,
-// and it is lifted until it is 1.5 cells above it, where no lookup reaches the plane's
-// cells (a cell of size c blends cells reaching 1.5 c from the sample). The cone along
+// and gathers its own light: its cells are those of the whole level nearest a third of
+// its height above the plane, and it is lifted until it is 1.5 cells above it, where no
+// lookup reaches the plane's cells (a cell of size c blends cells reaching 1.5 c from the
+// sample). That bound only sets how often the lift bends the cone towards the normal, so
+// the nearest level, not the one below it: the level below reads a pencil as little as a
+// sixth of the cone's width, whose streaks across the indirect light the cone's own
+// integral does not have (BENCHMARKS.md, session 32). The cone along
 // the normal sees its plane only from behind, which the facing weights hide
 // (anisotropic.glsl).
 vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lod, vec3 surface, vec3 n,
@@ -115,8 +119,9 @@ vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lo
     diameter = max(voxel, 2.0 * tan_half * dist);
     if (SNAPPED_CONES) {
         bool clear = dot(dir, n) < 0.9;
-        float cell = clear ? min(0.5 * diameter, height / 3.0) : 0.5 * diameter;
-        lod = max(floor(log2(max(cell, voxel) / voxel)), min_lod);
+        float wide = floor(log2(max(0.5 * diameter, voxel) / voxel));
+        float high = round(log2(max(height / 3.0, voxel) / voxel));
+        lod = max(clear ? min(wide, high) : wide, min_lod);
         footprint = voxel * exp2(lod);
         float above = (clear ? 1.5 : 1.125) * footprint;
         x += n * max(above - height, 0.0);
