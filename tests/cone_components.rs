@@ -221,7 +221,7 @@ fn furnace_inside_the_grid_within_two_percent() {
     }
 }
 
-/// `--snapped-cones` keeps that room closed: 0.998, 0.998 and 0.990 of the walls'
+/// `--snapped-cones` keeps that room closed: 0.998, 0.991 and 0.993 of the walls'
 /// radiance at 64³, 128³ and 256³, where the default lookups let a third of it out, more
 /// as the voxels get finer (0.960, 0.946 and 0.968 while the snapped cells blended two
 /// levels, before session 32).
@@ -966,7 +966,7 @@ fn conference_bounces_over_the_first_match_the_path_tracer_with_snapped_cones() 
     }
 }
 
-/// On `sibenik_main`, the same (0.998 and 0.959; 0.982 and 0.944 while the snapped cells
+/// On `sibenik_main`, the same (0.990 and 0.951; 0.982 and 0.944 while the snapped cells
 /// blended two levels, session 31).
 #[test]
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
