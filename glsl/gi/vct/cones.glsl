@@ -108,9 +108,8 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
 // sample). That bound only sets how often the lift bends the cone towards the normal, so
 // the nearest level, not the one below it: the level below reads a pencil as little as a
 // sixth of the cone's width, whose streaks across the indirect light the cone's own
-// integral does not have (BENCHMARKS.md, session 32). The cone along
-// the normal sees its plane only from behind, which the facing weights hide
-// (anisotropic.glsl).
+// integral does not have (BENCHMARKS.md, session 32). The cone along the normal sees
+// its plane only from behind, which the facing weights hide (anisotropic.glsl).
 vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lod, vec3 surface, vec3 n,
                  out float lod, out float diameter, out float footprint) {
     float voxel = vct.origin.w;
