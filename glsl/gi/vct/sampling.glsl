@@ -16,6 +16,12 @@ layout(set = SET_GI, binding = BINDING_VCT_DIRECTIONAL) uniform sampler3D voxel_
 // bind (see SPEC_SNAPPED_CONES).
 layout(constant_id = SPEC_SNAPPED_CONES) const bool SNAPPED_CONES = false;
 
+// Along one axis, the index of the cell, of `cells` across the grid, that holds the
+// texture coordinate `u` (`--snapped-cones`).
+float cell_holding(float u, float cells) {
+    return min(floor(clamp(u, 0.0, 1.0) * cells), cells - 1.0);
+}
+
 #ifndef OCTREE
 
 // The base level at `uvw`.
@@ -26,7 +32,7 @@ vec4 sample_base(vec3 uvw) {
 // Along one axis, the centre of the cell, of `cells` across the grid, that holds the
 // texture coordinate `u`.
 float cell_centre(float u, float cells) {
-    return (min(floor(clamp(u, 0.0, 1.0) * cells), cells - 1.0) + 0.5) / cells;
+    return (cell_holding(u, cells) + 0.5) / cells;
 }
 
 // The base level at `uvw` read three times, each at the centre of the voxel that holds
@@ -167,8 +173,7 @@ vec4 sample_base(vec3 uvw) {
 // brick's border holds that voxel where it lies in a neighbouring node.
 BrickSample snapped(BrickSample s, int axis, vec3 uvw, uint level) {
     float voxels = float(2u << level);
-    float q = clamp(uvw[axis], 0.0, 1.0) * voxels;
-    s.local[axis] += min(floor(q), voxels - 1.0) + 0.5 - q;
+    s.local[axis] += cell_holding(uvw[axis], voxels) + 0.5 - clamp(uvw[axis], 0.0, 1.0) * voxels;
     return s;
 }
 
