@@ -530,7 +530,7 @@ fn write_builtin_scene(dir: &std::path::Path) -> std::io::Result<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gi::vct::{ConeSettings, VctSettings};
+    use crate::gi::vct::{ConeSettings, Resolution, VctSettings};
 
     fn cone_tracing(settings: RenderSettings) -> VctSettings {
         match settings.gi {
@@ -617,7 +617,10 @@ mod tests {
             _ => unreachable!(),
         };
         let gi = cone_tracing(parse(&["voxcone", "render"]));
-        assert_eq!((gi.voxels, gi.cones.diffuse_cones), (32, 9));
+        assert_eq!(
+            (gi.voxels, gi.cones.diffuse_cones),
+            (Resolution::Count(32), 9)
+        );
         assert!(gi.shadow_cones);
         assert_eq!(gi.cones.step_factor, ConeSettings::default().step_factor);
         let gi = cone_tracing(parse(&[
@@ -628,7 +631,59 @@ mod tests {
             "--diffuse-cones",
             "4",
         ]));
-        assert_eq!((gi.voxels, gi.cones.diffuse_cones), (16, 4));
+        assert_eq!(
+            (gi.voxels, gi.cones.diffuse_cones),
+            (Resolution::Count(16), 4)
+        );
+    }
+
+    /// A count wins over a size from the same place, the command line over the scene
+    /// file; without either the device decides (`Resolution::Auto`).
+    #[test]
+    fn voxels_come_from_a_count_a_size_or_the_device() {
+        let parse =
+            |scene: GiOverrides, args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
+                Some(Command::Render(r)) => r.common.render_settings(&scene).map(cone_tracing),
+                _ => unreachable!(),
+            };
+        let none = GiOverrides::default();
+        let sized = GiOverrides {
+            voxel_size: Some(0.5),
+            ..Default::default()
+        };
+        let auto = |size| Resolution::Auto { size };
+        let voxels = |scene, args: &[&str]| parse(scene, args).unwrap().voxels;
+        assert_eq!(voxels(none, &["voxcone", "render"]), auto(None));
+        assert_eq!(voxels(sized, &["voxcone", "render"]), auto(Some(0.5)));
+        let args = ["voxcone", "render", "--voxels", "128"];
+        assert_eq!(voxels(sized, &args), Resolution::Count(128));
+        let args = ["voxcone", "render", "--voxel-size", "2"];
+        let counted = GiOverrides {
+            voxels: Some(32),
+            ..Default::default()
+        };
+        assert_eq!(voxels(counted, &args), auto(Some(2.0)));
+        let args = ["voxcone", "render", "--gi", "octree", "--octree-depth", "7"];
+        assert_eq!(voxels(sized, &args), Resolution::Count(128));
+        // The octree takes a given count's depth, checked at once.
+        let args = ["voxcone", "render", "--gi", "octree", "--voxels", "32"];
+        let err = parse(none, &args).unwrap_err();
+        assert!(format!("{err:#}").contains("--octree-depth"), "{err:#}");
+        let both = GiOverrides {
+            voxels: Some(32),
+            voxel_size: Some(0.5),
+            ..Default::default()
+        };
+        let err = parse(both, &["voxcone", "render"]).unwrap_err();
+        assert!(
+            format!("{err:#}").contains("both voxels and voxel_size"),
+            "{err:#}"
+        );
+        let args = ["voxcone", "render", "--voxel-size", "0"];
+        let err = parse(none, &args).unwrap_err();
+        assert!(format!("{err:#}").contains("positive length"), "{err:#}");
+        let args = ["voxcone", "render", "--voxels", "64", "--voxel-size", "1"];
+        assert!(Cli::try_parse_from(args).is_err());
     }
 
     /// The path tracer's cone component takes the gather's layout from the command line;

@@ -84,6 +84,10 @@ impl Renderer {
         extent: vk::Extent2D,
         output_format: vk::Format,
     ) -> Result<Self> {
+        let settings = RenderSettings {
+            gi: settings.gi.on(ctx, &scene),
+            ..settings
+        };
         let gpu = GpuScene::new(ctx, &scene)?;
         let frame_sets = DescriptorSets::new(
             ctx,

@@ -25,6 +25,7 @@ use crate::gi::path::cli::PathArgs;
 use crate::gi::probes::cli::{ProbeArgs, Switch};
 use crate::gi::vct::cli::VctArgs;
 use crate::gi::vct::voxelize::Voxelizer;
+use crate::gi::vct::CPU_VOXELS;
 use crate::gi::{DebugView, GiSettings};
 use crate::renderer::{Renderer, FRAMES_IN_FLIGHT};
 use crate::scene::{Light, LightKind};
@@ -445,12 +446,14 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                     egui::Slider::new(&mut ao_distance, 0.5..=16.0).text("AO distance (voxels)"),
                 ),
             );
+            // The renderer's settings hold the resolution the device and the scene gave.
+            let resolution = vct.voxels.count().unwrap_or(CPU_VOXELS);
             if octree {
-                let mut depth = vct.voxels.trailing_zeros();
+                let mut depth = resolution.trailing_zeros();
                 settle(ui.add(egui::Slider::new(&mut depth, 6..=10).text("octree depth")));
-                override_if(&mut args.octree_depth, depth, vct.voxels.trailing_zeros());
+                override_if(&mut args.octree_depth, depth, resolution.trailing_zeros());
             } else {
-                let mut voxels = vct.voxels;
+                let mut voxels = resolution;
                 egui::ComboBox::from_label("voxels")
                     .selected_text(format!("{voxels}³"))
                     .show_ui(ui, |ui| {
@@ -458,7 +461,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                             settle(ui.selectable_value(&mut voxels, v, format!("{v}³")));
                         }
                     });
-                override_if(&mut args.voxels, voxels, vct.voxels);
+                override_if(&mut args.voxels, voxels, resolution);
             }
             let mut wide = vct.cones.wide_steps_by_level;
             let mut cosine = vct.cones.cosine_cones;

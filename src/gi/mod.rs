@@ -44,6 +44,18 @@ pub enum GiSettings {
 }
 
 impl GiSettings {
+    /// The settings with what the device and the scene decide filled in (the voxel
+    /// grid's resolution), as the technique will run them.
+    pub fn on(&self, ctx: &Context, scene: &Scene) -> Self {
+        match self {
+            GiSettings::ConeTracing(vct) => GiSettings::ConeTracing(vct::VctSettings {
+                voxels: vct::Resolution::Count(vct.voxels.on(ctx, scene, &vct.cones)),
+                ..*vct
+            }),
+            other => other.clone(),
+        }
+    }
+
     /// Whether the technique filters each pixel itself (a path tracer's jittered camera
     /// rays), so that rendering more samples per pixel adds nothing.
     pub fn filters_pixels(&self) -> bool {

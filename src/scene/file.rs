@@ -47,7 +47,8 @@
 //! radiance = [0.3, 0.35, 0.45]   # constant environment radiance, default zero
 //!
 //! [gi]                           # optional; each key as its command-line option, which wins
-//! voxels = 64                    # --voxels
+//! voxels = 64                    # --voxels (default: by the device, see voxel_size)
+//! voxel_size = 0.05              # --voxel-size: instead of voxels, the largest voxel
 //! diffuse_cones = 6              # --diffuse-cones
 //! diffuse_aperture_deg = 60.0    # --diffuse-aperture
 //! step_factor = 0.25             # --step-factor

@@ -198,6 +198,8 @@ impl LoadOptions {
 #[serde(deny_unknown_fields)]
 pub struct GiOverrides {
     pub voxels: Option<u32>,
+    /// The largest voxel wanted, in scene units (`--voxel-size`).
+    pub voxel_size: Option<f32>,
     pub diffuse_cones: Option<u32>,
     pub diffuse_aperture_deg: Option<f32>,
     pub step_factor: Option<f32>,

@@ -105,6 +105,21 @@ impl Context {
         self.properties.device_type == vk::PhysicalDeviceType::CPU
     }
 
+    /// The largest device-local memory heap, bytes.
+    pub fn device_local_bytes(&self) -> u64 {
+        // SAFETY: `physical_device` was enumerated from `instance`, which outlives `self`.
+        let memory = unsafe {
+            self.instance
+                .get_physical_device_memory_properties(self.physical_device)
+        };
+        memory.memory_heaps[..memory.memory_heap_count as usize]
+            .iter()
+            .filter(|heap| heap.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+            .map(|heap| heap.size)
+            .max()
+            .unwrap_or(0)
+    }
+
     pub fn new(options: &ContextOptions) -> Result<Arc<Self>> {
         // SAFETY: loading the system Vulkan loader; failure is reported, not assumed.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| {

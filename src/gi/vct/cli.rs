@@ -6,18 +6,26 @@ use clap::Args;
 use super::octree::check_depth;
 use super::voxelize::Voxelizer;
 use super::{
-    check_voxels, ConeSettings, Store, VctSettings, DEFAULT_SAMPLED_EMITTERS, DEFAULT_VOXELS,
+    check_voxel_size, check_voxels, ConeSettings, Resolution, Store, VctSettings,
+    DEFAULT_SAMPLED_EMITTERS,
 };
 use crate::scene::GiOverrides;
 
 #[derive(Args, Debug, Clone, Default)]
 pub struct VctArgs {
-    /// Voxels per axis of the dense grid, a power of two from 4 to 1024 [default: 64,
-    /// or the scene file's [gi] voxels].
-    #[arg(long)]
+    /// Voxels per axis of the dense grid, a power of two from 4 to 1024 [default: the scene
+    /// file's [gi] voxels, else by the device: 64 on a CPU driver, 256 on a GPU (fewer
+    /// where its memory is short, or where --voxel-size asks for larger voxels)].
+    #[arg(long, conflicts_with = "voxel_size")]
     pub voxels: Option<u32>,
+    /// The largest voxel wanted, in scene units: the grid takes the least power of two
+    /// voxels per axis whose voxels are no larger, from 64 to the device's default
+    /// (--voxels).
+    #[arg(long, value_parser = crate::cli::parse_finite)]
+    pub voxel_size: Option<f32>,
     /// Levels of the sparse voxel octree (--gi octree), 6 to 10: an effective grid of
-    /// 2^depth voxels per axis [default: log2 of --voxels, so the dense default's 64³].
+    /// 2^depth voxels per axis [default: log2 of --voxels, or of the device's default
+    /// resolution].
     #[arg(long)]
     pub octree_depth: Option<u32>,
     /// Full aperture of each diffuse cone, degrees, 1 to 179 [default: 60].
@@ -107,6 +115,7 @@ impl VctArgs {
             (self.shadow_cones, "--shadow-cones"),
             (self.full_update, "--full-update"),
             (self.voxels.is_some(), "--voxels"),
+            (self.voxel_size.is_some(), "--voxel-size"),
             (self.octree_depth.is_some(), "--octree-depth"),
             (self.diffuse_aperture.is_some(), "--diffuse-aperture"),
             (self.step_factor.is_some(), "--step-factor"),
@@ -172,15 +181,42 @@ impl VctArgs {
             only_cone: None,
         };
         cones.check()?;
-        let voxels = self.voxels.or(scene.voxels).unwrap_or(DEFAULT_VOXELS);
-        let (voxels, store) = if octree {
-            let depth = self.octree_depth.unwrap_or(voxels.trailing_zeros());
-            check_depth(depth)?;
-            (1 << depth, Store::Octree { capacities: None })
-        } else {
-            (voxels, Store::Dense)
+        if scene.voxels.is_some() && scene.voxel_size.is_some() {
+            bail!("the scene file's [gi] gives both voxels and voxel_size: keep one");
+        }
+        // The command line over the scene file, a count or a size alike.
+        let voxels = match (self.voxels, self.voxel_size) {
+            (Some(count), _) => Resolution::Count(count),
+            (None, Some(size)) => Resolution::Auto { size: Some(size) },
+            (None, None) => match scene.voxels {
+                Some(count) => Resolution::Count(count),
+                None => Resolution::Auto {
+                    size: scene.voxel_size,
+                },
+            },
         };
-        check_voxels(voxels)?;
+        if let Resolution::Auto { size: Some(size) } = voxels {
+            check_voxel_size(size)?;
+        }
+        let store = if octree {
+            Store::Octree { capacities: None }
+        } else {
+            Store::Dense
+        };
+        let voxels = match (octree, self.octree_depth, voxels) {
+            (true, Some(depth), _) => {
+                check_depth(depth)?;
+                Resolution::Count(1 << depth)
+            }
+            (true, None, Resolution::Count(count)) => {
+                check_depth(count.trailing_zeros())?;
+                Resolution::Count(count)
+            }
+            (_, _, voxels) => voxels,
+        };
+        if let Resolution::Count(count) = voxels {
+            check_voxels(count)?;
+        }
         let sampled_emitters = self
             .sampled_emitters
             .or(scene.sampled_emitters)

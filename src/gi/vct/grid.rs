@@ -25,15 +25,21 @@ impl Grid {
     /// with a little room so that surfaces on the bounds are not cut by the grid's edge.
     pub fn around(scene: &Scene, resolution: u32) -> Self {
         let bounds = scene.swept_bounds();
-        // No floor in scene units (the scene may be in kilometres or micrometres), only a
-        // grid for a scene that is a single point.
-        let extent = (bounds.max - bounds.min).max_element();
-        let size = if extent > 0.0 { extent } else { 1.0 } * 1.04;
+        let size = Self::extent_around(scene);
         Self {
             origin: bounds.center() - Vec3::splat(size * 0.5),
             voxel_size: size / resolution as f32,
             resolution,
         }
+    }
+
+    /// The edge of the cube [`Grid::around`] puts around the scene.
+    pub fn extent_around(scene: &Scene) -> f32 {
+        let bounds = scene.swept_bounds();
+        // No floor in scene units (the scene may be in kilometres or micrometres), only a
+        // grid for a scene that is a single point.
+        let extent = (bounds.max - bounds.min).max_element();
+        (if extent > 0.0 { extent } else { 1.0 }) * 1.04
     }
 
     /// The voxels (first and last, each axis) that `bounds` touches, one more around

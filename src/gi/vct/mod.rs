@@ -30,8 +30,8 @@ pub use self::dense::Dense;
 pub use self::grid::Grid;
 pub use self::octree::Octree;
 pub use self::settings::{
-    auto_indirect_scale, check_voxels, ConeSettings, Store, VctSettings, DEFAULT_SAMPLED_EMITTERS,
-    DEFAULT_VOXELS,
+    auto_indirect_scale, auto_voxels, check_voxel_size, check_voxels, ConeSettings, Resolution,
+    Store, VctSettings, CPU_VOXELS, DEFAULT_SAMPLED_EMITTERS, GPU_VOXELS,
 };
 use super::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
@@ -338,7 +338,7 @@ impl<S: VoxelStore> ConeTracing<S> {
             set_layouts,
             frames_in_flight,
         } = *inputs;
-        let resolution = settings.voxels;
+        let resolution = settings.voxels.on(ctx, scene, &settings.cones);
         let cones = settings.cones;
         check_voxels(resolution)?;
         let rasterized = settings.voxelizer.on(ctx) == voxelize::Voxelizer::Raster;

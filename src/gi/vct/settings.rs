@@ -4,6 +4,9 @@ use anyhow::{bail, Result};
 
 use super::octree::Capacities;
 use super::voxelize::Voxelizer;
+use super::Grid;
+use crate::scene::Scene;
+use crate::vk::Context;
 
 /// Which structure holds the voxels.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,11 +20,114 @@ pub enum Store {
     },
 }
 
+/// Voxels per axis (a power of two): of the dense grid, or effective of the octree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Resolution {
+    /// As given: `--voxels`, `--octree-depth` or the scene file's `voxels`.
+    Count(u32),
+    /// From the device and the scene ([`auto_voxels`]); `size` is `--voxel-size` or the
+    /// scene file's `voxel_size`, the largest voxel wanted, in scene units.
+    Auto { size: Option<f32> },
+}
+
+impl Resolution {
+    /// The count, the rule applied for the device, the scene and the `cones` if it was
+    /// not given.
+    pub fn on(self, ctx: &Context, scene: &Scene, cones: &ConeSettings) -> u32 {
+        match self {
+            Self::Count(count) => count,
+            Self::Auto { size } => {
+                let gpu = (!ctx.is_cpu()).then(|| ctx.device_local_bytes());
+                let extent = Grid::extent_around(scene);
+                let count = auto_voxels(gpu, extent, size, cones.snapped_cones);
+                let device = if gpu.is_some() {
+                    "a GPU"
+                } else {
+                    "a CPU driver"
+                };
+                let voxel = extent / count as f32;
+                let why = match size {
+                    Some(size) => format!("voxels of at most {size} wanted, on {device}"),
+                    None if cones.snapped_cones => format!("the most on {device}"),
+                    None => "the default cones' resolution".to_owned(),
+                };
+                log::info!("voxels: {count}³ of {voxel} scene units ({why})");
+                if let Some(size) = size.filter(|&size| voxel > size) {
+                    log::warn!(
+                        "voxels of at most {size} wanted, but {count}³ is the most the default \
+                         gives on {device}: --voxels sets more"
+                    );
+                }
+                count
+            }
+        }
+    }
+
+    /// The count, once given or resolved by [`Resolution::on`].
+    pub fn count(self) -> Option<u32> {
+        match self {
+            Self::Count(count) => Some(count),
+            Self::Auto { .. } => None,
+        }
+    }
+}
+
+/// The rule's resolution on a CPU driver: lavapipe's speed case takes 300 to 360 ms of its
+/// 400 at 64³, and 2.6 times that at 128³ (BENCHMARKS.md, "The default resolution").
+/// Also the rule's least: the cones' settings are tuned and tested at 64³.
+pub const CPU_VOXELS: u32 = 64;
+/// The rule's resolution on a GPU: 256³ keeps the dense grid's whole update, every frame,
+/// within 3 ms on an H100 (Sponza, 1.72 ms); 512³ has eight times the voxels.
+pub const GPU_VOXELS: u32 = 256;
+/// The dense grid's bytes per voxel, volumes, their mips and the fragment sums (`bench`'s
+/// `memory_mib`: 2011 MiB at 256³).
+const BYTES_PER_VOXEL: u64 = 126;
+
+/// Voxels per axis when none are given.
+/// - The device sets the most: [`CPU_VOXELS`] on a CPU driver (`gpu` is `None`); on a GPU
+///   [`GPU_VOXELS`], halved while the grid would take more than a quarter of its
+///   device-local memory (`gpu`, bytes).
+/// - A wanted voxel `size` (in the units of the scene's `extent`) takes the least power of
+///   two whose voxels are no larger, from [`CPU_VOXELS`] to that most.
+/// - Without one, the most where finer voxels give a better image (`finer_helps`: the
+///   snapped cones, whose error falls from 64³ to 256³ on four of the five references),
+///   else [`CPU_VOXELS`]: the default cones are tuned there, and three of the five
+///   references get worse at 256³ (BENCHMARKS.md, "The default resolution").
+pub fn auto_voxels(gpu: Option<u64>, extent: f32, size: Option<f32>, finer_helps: bool) -> u32 {
+    let most = match gpu {
+        None => CPU_VOXELS,
+        Some(bytes) => {
+            let mut most = GPU_VOXELS;
+            while most > CPU_VOXELS && u64::from(most).pow(3) * BYTES_PER_VOXEL > bytes / 4 {
+                most /= 2;
+            }
+            most
+        }
+    };
+    match size {
+        // The quotient is finite and positive (both are checked), so the cast saturates at
+        // worst, and the clamp bounds it.
+        Some(size) => ((extent / size).ceil() as u32)
+            .checked_next_power_of_two()
+            .unwrap_or(u32::MAX)
+            .clamp(CPU_VOXELS, most),
+        None if finer_helps => most,
+        None => CPU_VOXELS,
+    }
+}
+
+/// Checks a wanted voxel size.
+pub fn check_voxel_size(size: f32) -> Result<()> {
+    if !(size.is_finite() && size > 0.0) {
+        bail!("--voxel-size / voxel_size must be a positive length in scene units, got {size}");
+    }
+    Ok(())
+}
+
 /// Voxel cone tracing.
 #[derive(Clone, Copy, Debug)]
 pub struct VctSettings {
-    /// Voxels per axis (a power of two): of the dense grid, or effective of the octree.
-    pub voxels: u32,
+    pub voxels: Resolution,
     pub store: Store,
     pub cones: ConeSettings,
     /// Direct light shadowed by soft-shadow cones through the voxels instead of by the
@@ -42,7 +148,7 @@ impl VctSettings {
     /// Default cones at `voxels` per axis in `store`.
     pub fn new(voxels: u32, store: Store) -> Self {
         Self {
-            voxels,
+            voxels: Resolution::Count(voxels),
             store,
             cones: ConeSettings::default(),
             shadow_cones: false,
@@ -172,9 +278,6 @@ pub fn auto_indirect_scale(height: u32) -> u32 {
     (height / 64).clamp(2, 8)
 }
 
-/// Voxels per axis unless the command line or the scene file says otherwise.
-pub const DEFAULT_VOXELS: u32 = 64;
-
 /// Checks a grid resolution.
 pub fn check_voxels(resolution: u32) -> Result<()> {
     if !resolution.is_power_of_two() || !(4..=1024).contains(&resolution) {
@@ -201,5 +304,39 @@ impl Default for ConeSettings {
             ao_distance_voxels: 4.0,
             only_cone: None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GIB: u64 = 1 << 30;
+
+    /// The rule: the device's most, fewer for a short memory or a large wanted voxel,
+    /// never under the CPU's; 64³ for the default cones unless a size is wanted.
+    #[test]
+    fn default_resolution_follows_the_device_and_the_scene() {
+        // A CPU driver: 64³ whatever its memory or the wanted size.
+        assert_eq!(auto_voxels(None, 10.0, None, true), CPU_VOXELS);
+        assert_eq!(auto_voxels(None, 10.0, Some(0.001), true), CPU_VOXELS);
+        // A GPU with 80 GiB: 256³ (2 GiB of grid); with 4 GiB, a quarter is 1 GiB: 128³.
+        assert_eq!(auto_voxels(Some(80 * GIB), 10.0, None, true), GPU_VOXELS);
+        assert_eq!(auto_voxels(Some(4 * GIB), 10.0, None, true), 128);
+        assert_eq!(auto_voxels(Some(GIB / 4), 10.0, None, true), CPU_VOXELS);
+        // Without a wanted size the default cones keep 64³ on every device.
+        assert_eq!(auto_voxels(Some(80 * GIB), 10.0, None, false), CPU_VOXELS);
+        // A wanted size: the least power of two whose voxels are no larger.
+        assert_eq!(auto_voxels(Some(80 * GIB), 10.0, Some(0.1), false), 128);
+        assert_eq!(auto_voxels(Some(80 * GIB), 12.8, Some(0.1), false), 128);
+        assert_eq!(auto_voxels(Some(80 * GIB), 12.81, Some(0.1), false), 256);
+        assert_eq!(
+            auto_voxels(Some(80 * GIB), 10.0, Some(5.0), false),
+            CPU_VOXELS
+        );
+        assert_eq!(
+            auto_voxels(Some(80 * GIB), 1e30, Some(1e-30), false),
+            GPU_VOXELS
+        );
     }
 }
