@@ -5,12 +5,15 @@ use std::sync::Arc;
 
 use super::super::reference;
 use super::super::voxelize::Voxelizer;
-use super::super::{Grid, Store};
+use super::super::{Grid, Resolution, Store, CPU_VOXELS};
 use super::Volume;
+use crate::gi::GiSettings;
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
-use crate::testing::{dense, gi_settings, moving_cube_scene, render_frames, with_voxelizer};
+use crate::testing::{
+    cone_settings, dense, gi_settings, moving_cube_scene, render_frames, with_voxelizer,
+};
 use crate::vk::Context;
 
 /// Renders 64x64 frames of `scene` with `--gi dense --voxels n`, one at each time,
@@ -288,4 +291,27 @@ fn voxel_list_holds_exactly_the_occupied_voxels() {
     assert!(count > 0);
     assert_eq!(listed, occupied);
     assert_eq!(ctx.validation_messages(), 0);
+}
+
+/// Without a given resolution the renderer applies the rule for its device, keeps the
+/// count in its settings (the viewer's panel shows it) and builds the grid at it: on a
+/// CPU driver 64³, with or without a wanted voxel size, snapped cones or not.
+#[test]
+fn the_default_resolution_reaches_the_grid() {
+    let scene = Scene::load(&crate::cli::default_scene(), &LoadOptions::default()).unwrap();
+    let extent = Grid::extent_around(&scene);
+    for (size, snapped) in [(None, false), (None, true), (Some(extent / 512.0), false)] {
+        let mut settings = gi_settings(0, Store::Dense, false);
+        let vct = cone_settings(&mut settings);
+        vct.voxels = Resolution::Auto { size };
+        vct.cones.snapped_cones = snapped;
+        let (ctx, renderer) = render_frames(scene.clone(), settings, &[0.0]);
+        assert_eq!(ctx.validation_messages(), 0);
+        assert!(ctx.is_cpu(), "the rule's GPU branch is tested on its own");
+        let GiSettings::ConeTracing(kept) = &renderer.settings.gi else {
+            panic!("no cone tracing");
+        };
+        assert_eq!(kept.voxels, Resolution::Count(CPU_VOXELS), "{size:?}");
+        assert_eq!(dense(&renderer).grid().resolution, CPU_VOXELS);
+    }
 }
