@@ -25,7 +25,7 @@ impl Grid {
     /// with a little room so that surfaces on the bounds are not cut by the grid's edge.
     pub fn around(scene: &Scene, resolution: u32) -> Self {
         let bounds = scene.swept_bounds();
-        let size = Self::extent_around(scene);
+        let size = cube_edge(&bounds);
         Self {
             origin: bounds.center() - Vec3::splat(size * 0.5),
             voxel_size: size / resolution as f32,
@@ -35,11 +35,7 @@ impl Grid {
 
     /// The edge of the cube [`Grid::around`] puts around the scene.
     pub fn extent_around(scene: &Scene) -> f32 {
-        let bounds = scene.swept_bounds();
-        // No floor in scene units (the scene may be in kilometres or micrometres), only a
-        // grid for a scene that is a single point.
-        let extent = (bounds.max - bounds.min).max_element();
-        (if extent > 0.0 { extent } else { 1.0 }) * 1.04
+        cube_edge(&scene.swept_bounds())
     }
 
     /// The voxels (first and last, each axis) that `bounds` touches, one more around
@@ -57,4 +53,12 @@ impl Grid {
         };
         Some([voxel(bounds.min, -1.0), voxel(bounds.max, 1.0)])
     }
+}
+
+/// The edge of the cube around `bounds`: their largest extent with a little room. No floor
+/// in scene units (the scene may be in kilometres or micrometres), only a grid for a scene
+/// that is a single point.
+fn cube_edge(bounds: &Aabb) -> f32 {
+    let extent = (bounds.max - bounds.min).max_element();
+    (if extent > 0.0 { extent } else { 1.0 }) * 1.04
 }
