@@ -361,6 +361,9 @@ impl CommonArgs {
     /// `--cone`, checked against the gather's cones.
     fn cone_component(&self, cones: &ConeSettings) -> Result<Option<u32>> {
         match self.cone {
+            Some(k) if cones.lattice_cones != 0 => {
+                bail!("--cone {k} picks a cone of the ring: --lattice-cones has none")
+            }
             Some(k) if k >= cones.diffuse_cones => bail!(
                 "--cone {k}: the diffuse gather has cones 0 to {} (--diffuse-cones {})",
                 cones.diffuse_cones - 1,
@@ -727,6 +730,37 @@ mod tests {
             err.to_string().contains("--voxels works on the voxels"),
             "{err}"
         );
+    }
+
+    /// `--lattice-cones` implies the snapped lookups and replaces the ring, whose options
+    /// and components it refuses.
+    #[test]
+    fn lattice_replaces_the_ring() {
+        let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
+            Some(Command::Render(r)) => r.common.render_settings(&GiOverrides::default()),
+            _ => unreachable!(),
+        };
+        let gi = cone_tracing(parse(&["voxcone", "render", "--lattice-cones", "72"]).unwrap());
+        assert_eq!(gi.cones.lattice_cones, 72);
+        assert!(gi.cones.snapped_cones);
+        for (args, message) in [
+            (&["--lattice-cones", "16"][..], "between 32 and 256, got 16"),
+            (
+                &["--lattice-cones", "72", "--cone", "1"],
+                "--lattice-cones has none",
+            ),
+            (
+                &["--lattice-cones", "72", "--diffuse-cones", "9"],
+                "--diffuse-cones / diffuse_cones sets the ring",
+            ),
+            (
+                &["--lattice-cones", "72", "--cosine-cones"],
+                "--cosine-cones / cosine_cones sets the ring",
+            ),
+        ] {
+            let err = parse(&[&["voxcone", "render"][..], args].concat()).unwrap_err();
+            assert!(format!("{err:#}").contains(message), "{err:#}");
+        }
     }
 
     #[test]

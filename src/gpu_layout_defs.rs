@@ -554,6 +554,14 @@ gpu_layout! {
         uint cosine_cones,
         /// Entries of `BINDING_VCT_EMITTERS`: the emitters whose light the cones' passes sample.
         uint emitter_count,
+        /// Cones of the diffuse gather's lattice (`--lattice-cones`), spread evenly over the cosine-weighted hemisphere; 0: the ring of `diffuse_cones`.
+        uint lattice_cones,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+        /// Unused.
+        uint pad2,
     }
 
     /// A planar group of emissive triangles whose light voxel cone tracing samples: their exact unoccluded irradiance, times one soft-shadow cone's visibility (`glsl/gi/vct/emitters.glsl`).

@@ -25,7 +25,7 @@ use crate::gi::path::cli::PathArgs;
 use crate::gi::probes::cli::{ProbeArgs, Switch};
 use crate::gi::vct::cli::VctArgs;
 use crate::gi::vct::voxelize::Voxelizer;
-use crate::gi::vct::CPU_VOXELS;
+use crate::gi::vct::{CPU_VOXELS, LATTICE_CONES};
 use crate::gi::{DebugView, GiSettings};
 use crate::renderer::{Renderer, FRAMES_IN_FLIGHT};
 use crate::scene::{Light, LightKind};
@@ -466,12 +466,15 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             let mut wide = vct.cones.wide_steps_by_level;
             let mut cosine = vct.cones.cosine_cones;
             let mut snapped = vct.cones.snapped_cones;
+            let lattice_was = vct.cones.lattice_cones != 0;
+            let mut lattice = lattice_was;
             let mut accumulate = vct.cones.accumulate_bounces;
             let mut full_update = vct.full_update;
             let mut voxelizer = vct.voxelizer;
             settle(ui.checkbox(&mut wide, "wide steps by level"));
             settle(ui.checkbox(&mut cosine, "cosine-weighted cones"));
             settle(ui.checkbox(&mut snapped, "snapped cones"));
+            settle(ui.checkbox(&mut lattice, "lattice of 72 cones"));
             settle(ui.checkbox(&mut accumulate, "accumulate bounces over frames"));
             settle(ui.checkbox(&mut full_update, "voxelize everything every frame"));
             egui::ComboBox::from_label("voxelizer")
@@ -484,6 +487,9 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             args.wide_steps_by_level = wide;
             args.cosine_cones = cosine;
             args.snapped_cones = snapped;
+            if lattice != lattice_was {
+                args.lattice_cones = Some(if lattice { LATTICE_CONES } else { 0 });
+            }
             args.no_accumulate = !accumulate;
             args.full_update = full_update;
             if voxelizer != vct.voxelizer {

@@ -57,6 +57,7 @@
 //! wide_steps_by_level = false    # --wide-steps-by-level
 //! cosine_cones = false           # --cosine-cones
 //! snapped_cones = false          # --snapped-cones
+//! lattice_cones = 72             # --lattice-cones (default: off, the ring of diffuse_cones)
 //! bounces = 8                    # --bounces
 //! indirect_scale = 2             # --indirect-scale (default: by image height)
 //! shadow_cones = false           # --shadow-cones

@@ -208,6 +208,7 @@ pub struct GiOverrides {
     pub wide_steps_by_level: Option<bool>,
     pub cosine_cones: Option<bool>,
     pub snapped_cones: Option<bool>,
+    pub lattice_cones: Option<u32>,
     pub bounces: Option<u32>,
     pub indirect_scale: Option<u32>,
     pub shadow_cones: Option<bool>,

@@ -361,6 +361,43 @@ vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surfa
     return weights > 0.0 ? sum / weights : vec4(0.0);
 }
 
+// The lattice gather (`--lattice-cones`, vct.lattice_cones > 0, with snapped lookups):
+// the cosine-weighted mean radiance over the hemisphere around n as the plain mean of N
+// narrow cones whose axes are spread evenly over the cosine-weighted hemisphere: a
+// Fibonacci spiral over the unit disc, lifted onto the hemisphere (Malley's method), so
+// that every cone stands for the same share of the integral and counts 1/N.
+// Why: a snapped lookup reads cells at most the cone's radius, so each cone responds to a
+// small bright feature as a tent about as wide as those cells, a pencil of its disc, not
+// the disc. The ring's cones (their sub-cones four to a cone) left the gather's response
+// to a small source 0 to 3.9 times the cosine's share across the hemisphere, 3.6 along
+// the normal (BENCHMARKS.md, session 34). Tents of half-width c set c apart sum to a
+// constant, so cones set about one cell apart give a response that follows the
+// lattice's density, which is the cosine's. The cells lie between half the radius and
+// the radius (whole levels), so a cone's half-angle is sqrt(2) times the lattice's
+// spacing, sqrt(pi / N) radians near the normal: their geometric mean is the spacing.
+// Towards the horizon the lifted lattice stretches along the meridian by 1 / cos(theta),
+// so the cones widen by its square root there (the stretch's mean over the two
+// directions), up to a cosine of 0.2. The cones near the normal must stay within 17
+// degrees, as the sub-cones that keep a closed room closed: at 72 cones they are 16.8
+// degrees; 48 (20.5 degrees) let a tenth of a closed box's light out.
+// Each cone steps as far as a cone of the ring would (as the sub-cones do).
+vec4 gather_lattice(vec3 surface, vec3 origin, vec3 n, float min_lod, int ao_volume, float step_factor) {
+    int count = int(vct.lattice_cones);
+    vec3 t = perpendicular(n);
+    vec3 b = cross(n, t);
+    float spacing = sqrt(3.14159265 / float(count));
+    vec4 sum = vec4(0.0);
+    for (int i = 0; i < count; i++) {
+        float r = sqrt((float(i) + 0.5) / float(count));
+        float phi = float(i) * 2.39996323;
+        vec3 d = normalize(r * cos(phi) * t + r * sin(phi) * b + sqrt(max(1.0 - r * r, 0.0)) * n);
+        float tan_half = tan(1.41421356 * spacing / sqrt(max(dot(d, n), 0.2)));
+        sum += trace_cone(origin, d, tan_half, min_lod, surface, n, ao_volume,
+                          step_factor * vct.diffuse_tan_half / tan_half);
+    }
+    return sum / float(count);
+}
+
 // Cosine-weighted mean radiance over the hemisphere around n of the surface at `surface`
 // from `cones` cones starting at `origin` (diffuse_cone_axis), each stepping
 // `step_factor` of its diameter, the ring's traced as sub-cones where `split_ring` (the
@@ -374,6 +411,11 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
         vec3 m = abs(n);
         int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
         ao_volume = 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
+    }
+    // (`--cone` picks a cone of the ring: the lattice has none.)
+    if (vct.lattice_cones > 0u) {
+        vec4 sum = gather_lattice(surface, origin, n, min_lod, ao_volume, step_factor);
+        return vec4(sum.rgb, 1.0 - sum.a);
     }
     vec3 t = perpendicular(n);
     vec3 b = cross(n, t);

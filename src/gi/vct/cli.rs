@@ -67,6 +67,13 @@ pub struct VctArgs {
     /// degrees, each traced on screen as narrower sub-cones [default: 6].
     #[arg(long)]
     pub diffuse_cones: Option<u32>,
+    /// Gather the diffuse light with N narrow cones spread evenly over the cosine-weighted
+    /// hemisphere (a Fibonacci lattice), 32 to 256, each counting 1/N, instead of the ring
+    /// of --diffuse-cones; implies --snapped-cones, and 72 keeps a closed room closed. The
+    /// image converges as the voxels get finer; it costs about three times the ring's
+    /// cone_trace and voxel bounce at 72 [default: off].
+    #[arg(long)]
+    pub lattice_cones: Option<u32>,
     /// Trace the cones (indirect light, soft shadows, specular, refraction) on one pixel of
     /// each NxN block and upsample, 1 to 8
     /// [default: height / 64, 2 to 8: 4 at 256 rows, 8 at 512 and above].
@@ -125,6 +132,7 @@ impl VctArgs {
             (self.cosine_cones, "--cosine-cones"),
             (self.snapped_cones, "--snapped-cones"),
             (self.diffuse_cones.is_some(), "--diffuse-cones"),
+            (self.lattice_cones.is_some(), "--lattice-cones"),
             (self.indirect_scale.is_some(), "--indirect-scale"),
             (self.no_accumulate, "--no-accumulate"),
             (self.bounces.is_some(), "--bounces"),
@@ -142,6 +150,24 @@ impl VctArgs {
     /// the command line over the scene file's `[gi]` over the defaults.
     pub fn settings(&self, octree: bool, scene: &GiOverrides) -> Result<VctSettings> {
         let d = ConeSettings::default();
+        let lattice_cones = self
+            .lattice_cones
+            .or(scene.lattice_cones)
+            .unwrap_or(d.lattice_cones);
+        // The lattice replaces the ring: its layout's options would be ignored.
+        let ring = [
+            (
+                self.diffuse_cones.or(scene.diffuse_cones).is_some(),
+                "--diffuse-cones / diffuse_cones",
+            ),
+            (
+                self.cosine_cones || scene.cosine_cones == Some(true),
+                "--cosine-cones / cosine_cones",
+            ),
+        ];
+        if let Some((_, option)) = ring.iter().find(|(set, _)| lattice_cones != 0 && *set) {
+            bail!("{option} sets the ring of cones: --lattice-cones / lattice_cones replaces it");
+        }
         let cones = ConeSettings {
             bounces: self.bounces.or(scene.bounces).unwrap_or(d.bounces),
             indirect_scale: self.indirect_scale.or(scene.indirect_scale),
@@ -168,7 +194,10 @@ impl VctArgs {
             wide_steps_by_level: self.wide_steps_by_level
                 || scene.wide_steps_by_level.unwrap_or(d.wide_steps_by_level),
             cosine_cones: self.cosine_cones || scene.cosine_cones.unwrap_or(d.cosine_cones),
-            snapped_cones: self.snapped_cones || scene.snapped_cones.unwrap_or(d.snapped_cones),
+            snapped_cones: self.snapped_cones
+                || scene.snapped_cones.unwrap_or(d.snapped_cones)
+                || lattice_cones > 0,
+            lattice_cones,
             accumulate_bounces: !self.no_accumulate,
             shadow_aperture_deg: self
                 .shadow_aperture

@@ -31,7 +31,7 @@ pub use self::grid::Grid;
 pub use self::octree::Octree;
 pub use self::settings::{
     auto_indirect_scale, auto_voxels, check_voxel_size, check_voxels, ConeSettings, Resolution,
-    Store, VctSettings, CPU_VOXELS, DEFAULT_SAMPLED_EMITTERS, GPU_VOXELS,
+    Store, VctSettings, CPU_VOXELS, DEFAULT_SAMPLED_EMITTERS, GPU_VOXELS, LATTICE_CONES,
 };
 use super::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
@@ -392,6 +392,10 @@ impl<S: VoxelStore> ConeTracing<S> {
             only_cone: cones.only_cone.unwrap_or(u32::MAX),
             cosine_cones: u32::from(cones.cosine_cones),
             emitter_count: sampled.emitters.len() as u32,
+            lattice_cones: cones.lattice_cones,
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         };
         let uniforms = Buffer::with_data(
             ctx,

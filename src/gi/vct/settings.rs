@@ -76,6 +76,12 @@ impl Resolution {
 /// 400 at 64³, and 2.6 times that at 128³ (BENCHMARKS.md, "The default resolution").
 /// Also the rule's least: the cones' settings are tuned and tested at 64³.
 pub const CPU_VOXELS: u32 = 64;
+
+/// The lattice gather's cone count that the viewer's panel offers (`--lattice-cones`):
+/// the fewest whose cones near the normal are no wider than 17 degrees, as the sub-cones
+/// that keep a closed room closed (48 cones, 21 degrees, let a tenth of its light out;
+/// BENCHMARKS.md, session 34).
+pub const LATTICE_CONES: u32 = 72;
 /// The rule's resolution on a GPU: 256³ keeps the dense grid's whole update, every frame,
 /// within 3 ms on an H100 (Sponza, 1.72 ms); 512³ has eight times the voxels.
 pub const GPU_VOXELS: u32 = 256;
@@ -189,6 +195,11 @@ pub struct ConeSettings {
     /// the normal traced as four sub-cones. Off by default: better on large rooms and as
     /// the voxels get finer, worse on the Cornell box at 64³ (BENCHMARKS.md, session 30).
     pub snapped_cones: bool,
+    /// Cones of the lattice gather (`--lattice-cones`), 0 for the ring of `diffuse_cones`:
+    /// this many narrow cones spread evenly over the cosine-weighted hemisphere, each
+    /// counting alike, in both the screen's gather and the voxel bounce. It reads the
+    /// voxels as `snapped_cones` does (which it implies).
+    pub lattice_cones: u32,
     /// Light bounces between voxels: 1 is direct light on the voxels only.
     pub bounces: u32,
     /// Indirect light is traced on one pixel of each `indirect_scale`² block and
@@ -263,6 +274,12 @@ impl ConeSettings {
                 bail!("{name} must be between {min} and {max}, got {value}");
             }
         }
+        if self.lattice_cones != 0 && !(32..=256).contains(&self.lattice_cones) {
+            bail!(
+                "--lattice-cones / lattice_cones must be between 32 and 256, got {}",
+                self.lattice_cones
+            );
+        }
         Ok(())
     }
 }
@@ -297,6 +314,7 @@ impl Default for ConeSettings {
             wide_steps_by_level: false,
             cosine_cones: false,
             snapped_cones: false,
+            lattice_cones: 0,
             bounces: 8,
             indirect_scale: None,
             accumulate_bounces: true,
