@@ -204,6 +204,8 @@ gpu_layout! {
         SPEC_OCTREE_DEPTH = 0;
         /// Specialization constant id, given to every pipeline of voxel cone tracing: 1 where the cones read the directional volumes snapped along each volume's axis, in cells half their diameter, the ring cones clear of their own surface and the cone along the normal as four sub-cones (`--snapped-cones`); 0 for trilinear lookups in cells as wide as the cone. A uniform there, tested in branches, was inlined by lavapipe as the depth was, and its passes grew resident memory by a megabyte a frame.
         SPEC_SNAPPED_CONES = 1;
+        /// Specialization constant id, given to every pipeline of voxel cone tracing: the cones of the screen's diffuse gather's lattice (`--lattice-cones`), spread evenly over the cosine-weighted hemisphere; 0 for the ring of `diffuse_cones`. A constant for the reason `SPEC_SNAPPED_CONES` is one; the ring's gather also ran 0.5 % slower on lavapipe with the lattice's branch on a uniform.
+        SPEC_LATTICE_CONES = 2;
         /// Workgroup size of the passes over fragments and over a level's nodes.
         OCTREE_GROUP_SIZE = 64;
         /// Workgroups along y of a dispatch over an update list: the border transfer, filter and spread passes share each node's work (texels, children, neighbours) among them, so that a short list still fills the GPU (1 on a CPU driver, where a workgroup costs more than the work it shares).
@@ -554,14 +556,6 @@ gpu_layout! {
         uint cosine_cones,
         /// Entries of `BINDING_VCT_EMITTERS`: the emitters whose light the cones' passes sample.
         uint emitter_count,
-        /// Cones of the diffuse gather's lattice (`--lattice-cones`), spread evenly over the cosine-weighted hemisphere; 0: the ring of `diffuse_cones`.
-        uint lattice_cones,
-        /// Unused.
-        uint pad0,
-        /// Unused.
-        uint pad1,
-        /// Unused.
-        uint pad2,
     }
 
     /// A planar group of emissive triangles whose light voxel cone tracing samples: their exact unoccluded irradiance, times one soft-shadow cone's visibility (`glsl/gi/vct/emitters.glsl`).

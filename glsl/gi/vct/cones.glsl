@@ -361,7 +361,7 @@ vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surfa
     return weights > 0.0 ? sum / weights : vec4(0.0);
 }
 
-// The lattice gather (`--lattice-cones`, vct.lattice_cones > 0, with snapped lookups):
+// The lattice gather (`--lattice-cones`, LATTICE_CONES > 0, with snapped lookups):
 // the cosine-weighted mean radiance over the hemisphere around n as the plain mean of N
 // narrow cones whose axes are spread evenly over the cosine-weighted hemisphere: a
 // Fibonacci spiral over the unit disc, lifted onto the hemisphere (Malley's method), so
@@ -381,8 +381,10 @@ vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surfa
 // degrees, as the sub-cones that keep a closed room closed: at 72 cones they are 16.8
 // degrees; 48 (20.5 degrees) let a tenth of a closed box's light out.
 // Each cone steps as far as a cone of the ring would (as the sub-cones do).
+layout(constant_id = SPEC_LATTICE_CONES) const uint LATTICE_CONES = 0u;
+
 vec4 gather_lattice(vec3 surface, vec3 origin, vec3 n, float min_lod, int ao_volume, float step_factor) {
-    int count = int(vct.lattice_cones);
+    int count = int(LATTICE_CONES);
     vec3 t = perpendicular(n);
     vec3 b = cross(n, t);
     float spacing = sqrt(3.14159265 / float(count));
@@ -412,8 +414,12 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
         int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
         ao_volume = 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
     }
-    // (`--cone` picks a cone of the ring: the lattice has none.)
-    if (vct.lattice_cones > 0u) {
+    // The screen's gather only (`split_ring`): the voxels' bounce keeps the ring, whose
+    // light the screen's gather then reads through the lattice. 72 cones from every voxel
+    // made a bounce at 256³ take 25 s in one dispatch on lavapipe, which crashed when
+    // other work shared its cores. (`--cone` picks a cone of the ring: the lattice has
+    // none.)
+    if (split_ring && LATTICE_CONES > 0u) {
         vec4 sum = gather_lattice(surface, origin, n, min_lod, ao_volume, step_factor);
         return vec4(sum.rgb, 1.0 - sum.a);
     }

@@ -67,11 +67,11 @@ pub struct VctArgs {
     /// degrees, each traced on screen as narrower sub-cones [default: 6].
     #[arg(long)]
     pub diffuse_cones: Option<u32>,
-    /// Gather the diffuse light with N narrow cones spread evenly over the cosine-weighted
-    /// hemisphere (a Fibonacci lattice), 32 to 256, each counting 1/N, instead of the ring
-    /// of --diffuse-cones; implies --snapped-cones, and 72 keeps a closed room closed. The
-    /// image converges as the voxels get finer; it costs about three times the ring's
-    /// cone_trace and voxel bounce at 72 [default: off].
+    /// Gather the pixels' diffuse light with N narrow cones spread evenly over the
+    /// cosine-weighted hemisphere (a Fibonacci lattice), 32 to 256, each counting 1/N,
+    /// instead of the ring of --diffuse-cones (the voxel bounce keeps the ring); implies
+    /// --snapped-cones, and 72 keeps a closed room closed. The image converges as the
+    /// voxels get finer, at 3.9 times the default cone_trace on lavapipe [default: off].
     #[arg(long)]
     pub lattice_cones: Option<u32>,
     /// Trace the cones (indirect light, soft shadows, specular, refraction) on one pixel of

@@ -243,11 +243,11 @@ pub(crate) fn bind_cone_samples<'a>(
 
 /// What every pipeline of voxel cone tracing is made with: the layouts of sets 0 to 3,
 /// and the specialization constants (`SPEC_OCTREE_DEPTH`, which the dense grid's shaders
-/// do not declare and so ignore, and `SPEC_SNAPPED_CONES`).
+/// do not declare and so ignore, `SPEC_SNAPPED_CONES` and `SPEC_LATTICE_CONES`).
 #[derive(Clone, Copy)]
 pub struct PipelineBase {
     pub sets: [vk::DescriptorSetLayout; 4],
-    constants: [u32; 2],
+    constants: [u32; 3],
 }
 
 impl PipelineBase {
@@ -259,9 +259,10 @@ impl PipelineBase {
         grid: &Grid,
         cones: &ConeSettings,
     ) -> Self {
-        let mut constants = [0; 2];
+        let mut constants = [0; 3];
         constants[layout::SPEC_OCTREE_DEPTH as usize] = grid.resolution.ilog2();
         constants[layout::SPEC_SNAPPED_CONES as usize] = u32::from(cones.snapped_cones);
+        constants[layout::SPEC_LATTICE_CONES as usize] = cones.lattice_cones;
         Self {
             sets: [set_layouts[0], set_layouts[1], set_layouts[2], store_set],
             constants,
@@ -392,10 +393,6 @@ impl<S: VoxelStore> ConeTracing<S> {
             only_cone: cones.only_cone.unwrap_or(u32::MAX),
             cosine_cones: u32::from(cones.cosine_cones),
             emitter_count: sampled.emitters.len() as u32,
-            lattice_cones: cones.lattice_cones,
-            pad0: 0,
-            pad1: 0,
-            pad2: 0,
         };
         let uniforms = Buffer::with_data(
             ctx,

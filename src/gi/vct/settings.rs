@@ -197,8 +197,8 @@ pub struct ConeSettings {
     pub snapped_cones: bool,
     /// Cones of the lattice gather (`--lattice-cones`), 0 for the ring of `diffuse_cones`:
     /// this many narrow cones spread evenly over the cosine-weighted hemisphere, each
-    /// counting alike, in both the screen's gather and the voxel bounce. It reads the
-    /// voxels as `snapped_cones` does (which it implies).
+    /// counting alike, in the screen's gather (the voxel bounce keeps the ring). It reads
+    /// the voxels as `snapped_cones` does (which it implies).
     pub lattice_cones: u32,
     /// Light bounces between voxels: 1 is direct light on the voxels only.
     pub bounces: u32,
