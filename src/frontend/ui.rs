@@ -474,7 +474,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             settle(ui.checkbox(&mut wide, "wide steps by level"));
             settle(ui.checkbox(&mut cosine, "cosine-weighted cones"));
             settle(ui.checkbox(&mut snapped, "snapped cones"));
-            settle(ui.checkbox(&mut lattice, "lattice of 72 cones"));
+            settle(ui.checkbox(&mut lattice, format!("lattice of {LATTICE_CONES} cones")));
             settle(ui.checkbox(&mut accumulate, "accumulate bounces over frames"));
             settle(ui.checkbox(&mut full_update, "voxelize everything every frame"));
             egui::ComboBox::from_label("voxelizer")

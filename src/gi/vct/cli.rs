@@ -68,7 +68,7 @@ pub struct VctArgs {
     #[arg(long)]
     pub diffuse_cones: Option<u32>,
     /// Gather the pixels' diffuse light with N narrow cones spread evenly over the
-    /// cosine-weighted hemisphere (a Fibonacci lattice), 32 to 256, each counting 1/N,
+    /// cosine-weighted hemisphere (a Fibonacci lattice), 32 to 256 (0: off), each counting 1/N,
     /// instead of the ring of --diffuse-cones (the voxel bounce keeps the ring); implies
     /// --snapped-cones, and 72 keeps a closed room closed. The image converges as the
     /// voxels get finer, at 3.9 times the default cone_trace on lavapipe [default: off].
