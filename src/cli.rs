@@ -733,7 +733,7 @@ mod tests {
     }
 
     /// `--lattice-cones` implies the snapped lookups and replaces the ring, whose options
-    /// and components it refuses.
+    /// and components it refuses; snapped cones refuse the steps' options.
     #[test]
     fn lattice_replaces_the_ring() {
         let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
@@ -756,6 +756,14 @@ mod tests {
             (
                 &["--lattice-cones", "72", "--cosine-cones"],
                 "--cosine-cones / cosine_cones sets the ring",
+            ),
+            (
+                &["--lattice-cones", "72", "--step-factor", "0.3"],
+                "--step-factor / step_factor sets the steps of the trilinear cones",
+            ),
+            (
+                &["--snapped-cones", "--wide-steps-by-level"],
+                "snapped cones (--snapped-cones, --lattice-cones) march from cell to cell",
             ),
         ] {
             let err = parse(&[&["voxcone", "render"][..], args].concat()).unwrap_err();

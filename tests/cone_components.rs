@@ -1013,13 +1013,10 @@ fn bounces_over_the_first_with_snapped_cones(name: &str) -> Vec<f64> {
     ratios
 }
 
-/// On `conference_main`, within 5 % at 64³ and at 256³ (session 31 measured 0.980 and
-/// 0.969; with the voxels' cone along the normal whole, as before it, 0.927 and 0.861).
+/// On `conference_main`, within 5 % at 64³ and at 256³ (1.027 and 0.959 since the cones
+/// march cell by cell, session 35; 1.050 and 0.975 before; session 31 measured 0.980 and
+/// 0.969, and with the voxels' cone along the normal whole 0.927 and 0.861).
 #[test]
-#[cfg_attr(
-    voxcone_shared,
-    ignore = "issue 20: 1.050 of the path tracer's at 64³ (just over 5 %), 0.975 at 256³ (session 32: at 64³ every bounce over-gathers, the first by 1.15)"
-)]
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn conference_bounces_over_the_first_match_the_path_tracer_with_snapped_cones() {
     for r in bounces_over_the_first_with_snapped_cones("conference_main") {
@@ -1185,7 +1182,7 @@ fn flip_does_not_rise_as_the_voxels_get_finer() {
 #[test]
 #[cfg_attr(
     voxcone_shared,
-    ignore = "issue 20: sibenik_main 0.0591 → 0.0654 (session 32; the others hold)"
+    ignore = "issue 20: sponza_main 0.1479 → 0.1532, sibenik_main 0.0580 → 0.0645 (session 35; the others hold)"
 )]
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn flip_does_not_rise_as_the_voxels_get_finer_with_snapped_cones() {
@@ -1329,11 +1326,13 @@ fn small_emitter_is_gathered_in_the_cosines_share_from_every_direction() {
 
 /// The same emitter gathered through the voxels (`--sampled-emitters 0`), as a bounce's
 /// light is: the gather's own response to a small source, which with exact cones would
-/// follow their discs. With `--lattice-cones 72` it stays within half and twice the
-/// cosine's share from the normal to 70 degrees, at 256³ (0.568 at 70 degrees to 1.959
-/// along the normal, whose excess is not understood yet); the ring with
-/// `--snapped-cones` gave 3.6 along the normal and 0.15 at 30 degrees, its cones reading
-/// pencils of their discs (BENCHMARKS.md, session 34).
+/// follow their discs. With `--lattice-cones 72` it stays within 0.45 and 1.5 of the
+/// cosine's share from the normal to 70 degrees, at 256³ (0.50 at 70 degrees to 1.27
+/// along the normal, which the voxelization's widening by up to a voxel explains). Before
+/// the cones marched cell by cell, the emitter straight above, met where they change
+/// level, was gathered twice (1.96); the ring with `--snapped-cones` gave 3.6 along the
+/// normal and 0.15 at 30 degrees, its cones reading pencils of their discs (BENCHMARKS.md,
+/// sessions 34 and 35).
 #[test]
 fn lattice_gathers_a_small_voxel_emitter_in_the_cosines_share() {
     let dir = temp_dir("components_small_emitter_lattice");
@@ -1345,12 +1344,12 @@ fn lattice_gathers_a_small_voxel_emitter_in_the_cosines_share() {
             eprintln!(
                 "small voxel emitter at {theta}°, azimuth {phi}°: {r:.3} of the path tracer's"
             );
-            if !(0.5..=2.0).contains(&r) {
+            if !(0.45..=1.5).contains(&r) {
                 off.push((theta, phi, r));
             }
         }
     }
-    assert!(off.is_empty(), "outside half and twice: {off:?}");
+    assert!(off.is_empty(), "outside 0.45 and 1.5: {off:?}");
 }
 
 /// The same emitter straight above: at 64³ (4 voxels across) it gives what it gives at

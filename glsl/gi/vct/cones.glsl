@@ -86,46 +86,13 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
 // bends the ring cones too far, and lifting every sample a whole cone diameter bends the
 // slanted cones towards the normal, far off their axis (BENCHMARKS.md, the dense grid's
 // quality history).
-//
-// SNAPPED_CONES (`--snapped-cones`) reads each directional volume whole along its axis
-// (sampling.glsl). A cell's value along its axis is its children composited front to
-// back, so a wall anywhere in a crossed cell stops the cone whatever the step's phase,
-// where a lookup between two cells along the axis averaged the wall's cell with the empty
-// one beside it: a wall one voxel thick passed 31 % of the light at 64³, and a closed
-// room lost what its walls let through to the empty space beyond them. Across the cone
-// the lookup stays linear: there interpolated opacity is the covered share. The cells are
-// those of the whole level at most half the diameter (no blend with the next level), so
-// that the tent across them reaches no further than the cone: a coarser cell holding the
-// end of a wall that the cone meets face-on (a room's far wall where it meets a side wall)
-// is only partly covered, the rest lying beyond the side wall where none of the cone's rays
-// go, and blended in by its centre's distance it let a tenth of the light out through
-// the far wall (a closed box inside the grid, the cone along the normal: 0.90 of the
-// walls' light at 256³, 0.99 with whole levels; BENCHMARKS.md, session 32). A cone more
-// than 26 degrees off the normal reads its own plane in the volumes it crosses edge-on,
-// and gathers its own light: its cells are those of the whole level nearest a third of
-// its height above the plane, and it is lifted until it is 1.5 cells above it, where no
-// lookup reaches the plane's cells (a cell of size c blends cells reaching 1.5 c from the
-// sample). That bound only sets how often the lift bends the cone towards the normal, so
-// the nearest level, not the one below it: the level below reads a pencil as little as a
-// sixth of the cone's width, whose streaks across the indirect light the cone's own
-// integral does not have (BENCHMARKS.md, session 32). The cone along the normal sees
-// its plane only from behind, which the facing weights hide (anisotropic.glsl).
+
 vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lod, vec3 surface, vec3 n,
                  out float lod, out float diameter, out float footprint) {
     float voxel = vct.origin.w;
     vec3 x = origin + dir * dist;
     float height = dot(x - surface, n);
     diameter = max(voxel, 2.0 * tan_half * dist);
-    if (SNAPPED_CONES) {
-        bool clear = dot(dir, n) < 0.9;
-        float wide = floor(log2(max(0.5 * diameter, voxel) / voxel));
-        float high = round(log2(max(height / 3.0, voxel) / voxel));
-        lod = max(clear ? min(wide, high) : wide, min_lod);
-        footprint = voxel * exp2(lod);
-        float above = (clear ? 1.5 : 1.125) * footprint;
-        x += n * max(above - height, 0.0);
-        return (x - vct.origin.xyz) / (voxel * float(vct.resolution));
-    }
     lod = max(log2(min(diameter, max(height, voxel)) / voxel), min_lod);
     // The cell size at that mip, also where min_lod holds the mip above what the cone
     // asks for (its opacity was filtered over that path).
@@ -157,6 +124,128 @@ float grid_exit(vec3 a, vec3 b) {
 // sessions 10 and 11).
 const float GRID_FACE_PATH = 0.65;
 
+// The whole level a snapped cone reads at `dist` along its axis, `height` above its
+// surface's plane (march_cells), at most `top`.
+float snapped_level(float dist, float tan_half, float height, bool clear, float min_lod, float top) {
+    float voxel = vct.origin.w;
+    float wide = floor(log2(max(tan_half * dist, voxel) / voxel));
+    float high = round(log2(max(height / 3.0, voxel) / voxel));
+    return min(max(clear ? min(wide, high) : wide, min_lod), top);
+}
+
+// The snapped cones' march (`--snapped-cones`, SNAPPED_CONES): as trace_cone, but cell by
+// cell through the level it reads, each cell counted for the path the cone's axis runs
+// inside it.
+//
+// Each directional volume is read whole along its axis (sampling.glsl). A cell's value
+// along its axis is its children composited front to back, so a wall anywhere in a
+// crossed cell stops the cone whatever the step's phase, where a lookup between two cells
+// along the axis averaged the wall's cell with the empty one beside it: a wall one voxel
+// thick passed 31 % of the light at 64³, and a closed room lost what its walls let
+// through to the empty space beyond them. Across the cone the lookup stays linear: there
+// interpolated opacity is the covered share. The cells are those of the whole level at
+// most half the diameter (no blend with the next level), so that the tent across them
+// reaches no further than the cone: a coarser cell holding the end of a wall that the cone
+// meets face-on (a room's far wall where it meets a side wall) is only partly covered,
+// the rest lying beyond the side wall where none of the cone's rays go, and blended in by
+// its centre's distance it let a tenth of the light out through the far wall (a closed
+// box inside the grid, the cone along the normal: 0.90 of the walls' light at 256³, 0.99
+// with whole levels; BENCHMARKS.md, session 32). A cone more than 26 degrees off the
+// normal reads its own plane in the volumes it crosses edge-on, and gathers its own
+// light: its cells are those of the whole level nearest a third of its height above the
+// plane, and it is lifted until it is 1.5 cells above it, where no lookup reaches the
+// plane's cells (a cell of size c blends cells reaching 1.5 c from the sample). That
+// bound only sets how often the lift bends the cone towards the normal, so the nearest
+// level, not the one below it: the level below reads a pencil as little as a sixth of the
+// cone's width, whose streaks across the indirect light the cone's own integral does not
+// have (BENCHMARKS.md, session 32). The cone along the normal sees its plane only from
+// behind, which the facing weights hide (anisotropic.glsl).
+//
+// Why cell by cell: a whole cell's value stands for all of its length along the axis, so
+// the march must count each stretch of the axis once, in the cell that holds it. Samples
+// a step apart count the step in the cell at its start, and a step that reached the next
+// level counted that level's cell whole, though the finer cells before it had counted its
+// first part already: a small emitter facing the receiver, met where the cones change
+// level, was gathered twice (BENCHMARKS.md, session 35). So the march runs from face to
+// face of the cells it reads, samples each in the middle of its chord, counts the chord,
+// and takes up a coarser level only where it enters a new cell of that level through a
+// face across its dominant axis, whose volume carries most of the optical depth (a face
+// across another axis leaves the part of the coarse cell it has crossed along the
+// dominant axis counted twice). A finer level is taken up at once: every face of a cell
+// is a face of the finer cells. No step factor: the cells set the steps.
+vec4 march_cells(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surface, vec3 n, int ao_volume) {
+    float voxel = vct.origin.w;
+    float cells = float(vct.resolution);
+    float top = float(vct.directional_levels);
+    bool clear = dot(dir, n) < 0.9;
+    vec3 m = abs(dir);
+    int dominant = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
+    // Where the axis starts, in voxels from the grid's corner; 1/dir per axis, huge
+    // where the axis runs along the faces.
+    vec3 start = (origin - vct.origin.xyz) / voxel;
+    vec3 inv = 1.0 / mix(vec3(1e-9), dir, greaterThan(m, vec3(1e-9)));
+    vec4 acc = vec4(0.0);
+    float ao = 0.0;
+    float ao_alpha = 0.0;
+    float dist = voxel;
+    float lod = snapped_level(dist, tan_half, dot(dir, n) * dist + dot(origin - surface, n), clear, min_lod, top);
+    bool at_face = false;
+    vec3 p = start + dir * (dist / voxel);
+    while (acc.a < 0.99 && dist < vct.max_distance && all(greaterThanEqual(p, vec3(0.0))) &&
+           all(lessThanEqual(p, vec3(cells)))) {
+        float cell = exp2(lod);
+        vec3 q = p / cell;
+        // The cell the axis enters at p (on a face, the one ahead), and its exit face.
+        vec3 ahead = step(0.0, dir);
+        vec3 face = floor(q + (2.0 * ahead - 1.0) * 1e-4) + ahead;
+        vec3 t3 = (face - q) * inv;
+        float chord = max(min(t3.x, min(t3.y, t3.z)), 1e-4);
+        int exit_axis = t3.x <= t3.y && t3.x <= t3.z ? 0 : (t3.y <= t3.z ? 1 : 2);
+        float footprints = at_face ? GRID_FACE_PATH : chord;
+        vec3 x = vct.origin.xyz + voxel * (at_face ? p : p + dir * (0.5 * chord * cell));
+        float height = dot(x - surface, n);
+        x += n * max((clear ? 1.5 : 1.125) * cell * voxel - height, 0.0);
+        vec3 uvw = clamp((x - vct.origin.xyz) / (voxel * cells), 0.0, 1.0);
+        // Cones that never read the base level (min_lod >= 1, the diffuse ones) skip its
+        // fetches: the branch is on a constant once inlined.
+        vec4 s = min_lod >= 1.0 ? sample_directional_volumes(uvw, dir, lod - 1.0) : sample_voxels(uvw, dir, lod);
+        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), footprints);
+        vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
+        acc.rgb += (1.0 - acc.a) * rgb;
+        acc.a += (1.0 - acc.a) * a;
+        if (ao_volume >= 0) {
+            float o = sample_directional(ao_volume, uvw, max(lod - 1.0, 0.0)).a;
+            o = 1.0 - pow(1.0 - clamp(o, 0.0, 0.9999), footprints);
+            ao += (1.0 - ao_alpha) * o / (1.0 + dist / vct.ao_distance);
+            ao_alpha += (1.0 - ao_alpha) * o;
+        }
+        if (at_face) {
+            break;
+        }
+        dist += chord * cell * voxel;
+        p = start + dir * (dist / voxel);
+        float exit_face = face[exit_axis] * cell;
+        if (exit_face <= 0.0 || exit_face >= cells) {
+            // The grid's face: one more sample, as trace_cone's, in the same loop.
+            at_face = true;
+            p = clamp(p, vec3(0.0), vec3(cells));
+            lod = max(lod - 1.0, min_lod);
+            continue;
+        }
+        float want = snapped_level(dist, tan_half, dot(dir, n) * dist + dot(origin - surface, n), clear, min_lod, top);
+        if (want < lod) {
+            lod = want;
+        }
+        float crossed = face[exit_axis];
+        while (want > lod && exit_axis == dominant && mod(crossed, 2.0) == 0.0) {
+            crossed *= 0.5;
+            lod += 1.0;
+        }
+    }
+    acc.rgb += (1.0 - acc.a) * frame.sky_radiance.rgb;
+    return vec4(acc.rgb, ao);
+}
+
 // Front-to-back accumulation along one cone leaving the surface at `surface` with normal
 // `n`; returns premultiplied radiance (rgb) with the sky behind whatever the cone leaves
 // open, and (a) the occlusion that ambient occlusion counts, each occluder weighted down
@@ -168,6 +257,9 @@ const float GRID_FACE_PATH = 0.65;
 // the cone's diameter there.
 vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surface, vec3 n, int ao_volume,
                 float step_factor) {
+    if (SNAPPED_CONES) {
+        return march_cells(origin, dir, tan_half, min_lod, surface, n, ao_volume);
+    }
     vec4 acc = vec4(0.0);
     float ao = 0.0;
     float ao_alpha = 0.0;
@@ -191,10 +283,6 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surfa
         // distance, so twice as wide, reading the next coarser level (min_lod marks them).
         float step_length = (vct.wide_steps_by_level != 0u && min_lod >= 1.0) ? max(dist, diameter * step_factor)
                                                                               : diameter * step_factor;
-        // Snapped lookups take a crossed cell whole: no step may skip one.
-        if (SNAPPED_CONES) {
-            step_length = min(step_length, footprint);
-        }
         float next_lod;
         float next_diameter;
         float next_footprint;
@@ -380,10 +468,9 @@ vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surfa
 // directions), up to a cosine of 0.2. The cones near the normal must stay within 17
 // degrees, as the sub-cones that keep a closed room closed: at 72 cones they are 16.8
 // degrees; 48 (20.5 degrees) let a tenth of a closed box's light out.
-// Each cone steps as far as a cone of the ring would (as the sub-cones do).
 layout(constant_id = SPEC_LATTICE_CONES) const uint LATTICE_CONES = 0u;
 
-vec4 gather_lattice(vec3 surface, vec3 origin, vec3 n, float min_lod, int ao_volume, float step_factor) {
+vec4 gather_lattice(vec3 surface, vec3 origin, vec3 n, float min_lod, int ao_volume) {
     int count = int(LATTICE_CONES);
     vec3 t = perpendicular(n);
     vec3 b = cross(n, t);
@@ -394,8 +481,7 @@ vec4 gather_lattice(vec3 surface, vec3 origin, vec3 n, float min_lod, int ao_vol
         float phi = float(i) * 2.39996323;
         vec3 d = normalize(r * cos(phi) * t + r * sin(phi) * b + sqrt(max(1.0 - r * r, 0.0)) * n);
         float tan_half = tan(1.41421356 * spacing / sqrt(max(dot(d, n), 0.2)));
-        sum += trace_cone(origin, d, tan_half, min_lod, surface, n, ao_volume,
-                          step_factor * vct.diffuse_tan_half / tan_half);
+        sum += march_cells(origin, d, tan_half, min_lod, surface, n, ao_volume);
     }
     return sum / float(count);
 }
@@ -420,7 +506,7 @@ vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod,
     // other work shared its cores. (`--cone` picks a cone of the ring: the lattice has
     // none.)
     if (split_ring && LATTICE_CONES > 0u) {
-        vec4 sum = gather_lattice(surface, origin, n, min_lod, ao_volume, step_factor);
+        vec4 sum = gather_lattice(surface, origin, n, min_lod, ao_volume);
         return vec4(sum.rgb, 1.0 - sum.a);
     }
     vec3 t = perpendicular(n);

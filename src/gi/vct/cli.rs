@@ -32,11 +32,12 @@ pub struct VctArgs {
     #[arg(long, value_parser = crate::cli::parse_finite)]
     pub diffuse_aperture: Option<f32>,
     /// Step of the cones gathering light for the pixels (diffuse, specular, refraction)
-    /// as a fraction of the cone's diameter (beta), 0.05 to 2 [default: 0.25].
+    /// as a fraction of the cone's diameter (beta), 0.05 to 2; not with --snapped-cones,
+    /// whose cones march from cell to cell [default: 0.25].
     #[arg(long, value_parser = crate::cli::parse_finite)]
     pub step_factor: Option<f32>,
     /// Step of the voxel bounce's diffuse cones as a fraction of the cone's diameter,
-    /// 0.05 to 2 [default: 0.5].
+    /// 0.05 to 2; not with --snapped-cones [default: 0.5].
     #[arg(long, value_parser = crate::cli::parse_finite)]
     pub bounce_step_factor: Option<f32>,
     /// Step of the soft-shadow cones as a fraction of the cone's diameter, 0.05 to 2
@@ -44,7 +45,8 @@ pub struct VctArgs {
     #[arg(long, value_parser = crate::cli::parse_finite)]
     pub shadow_step_factor: Option<f32>,
     /// Step the diffuse cones level by level, each sample twice as far and wide as the
-    /// last (Dřínovský's sampling of wide cones), instead of by the step factor.
+    /// last (Dřínovský's sampling of wide cones), instead of by the step factor; not
+    /// with --snapped-cones.
     #[arg(long)]
     pub wide_steps_by_level: bool,
     /// Weight the diffuse gather's cones by the cosine: each ring cone's sub-cones by the
@@ -71,7 +73,7 @@ pub struct VctArgs {
     /// cosine-weighted hemisphere (a Fibonacci lattice), 32 to 256 (0: off), each counting 1/N,
     /// instead of the ring of --diffuse-cones (the voxel bounce keeps the ring); implies
     /// --snapped-cones, and 72 keeps a closed room closed. The image converges as the
-    /// voxels get finer, at 3.9 times the default cone_trace on lavapipe [default: off].
+    /// voxels get finer, at 4.3 times the default cone_trace on lavapipe [default: off].
     #[arg(long)]
     pub lattice_cones: Option<u32>,
     /// Trace the cones (indirect light, soft shadows, specular, refraction) on one pixel of
@@ -168,6 +170,33 @@ impl VctArgs {
         if let Some((_, option)) = ring.iter().find(|(set, _)| lattice_cones != 0 && *set) {
             bail!("{option} sets the ring of cones: --lattice-cones / lattice_cones replaces it");
         }
+        let snapped_cones = self.snapped_cones
+            || scene.snapped_cones.unwrap_or(d.snapped_cones)
+            || lattice_cones > 0;
+        // Snapped cones march from cell to cell (cones.glsl, march_cells): the steps'
+        // options would be ignored.
+        let steps = [
+            (
+                self.step_factor.or(scene.step_factor).is_some(),
+                "--step-factor / step_factor",
+            ),
+            (
+                self.bounce_step_factor
+                    .or(scene.bounce_step_factor)
+                    .is_some(),
+                "--bounce-step-factor / bounce_step_factor",
+            ),
+            (
+                self.wide_steps_by_level || scene.wide_steps_by_level == Some(true),
+                "--wide-steps-by-level / wide_steps_by_level",
+            ),
+        ];
+        if let Some((_, option)) = steps.iter().find(|(set, _)| snapped_cones && *set) {
+            bail!(
+                "{option} sets the steps of the trilinear cones: snapped cones (--snapped-cones, \
+                 --lattice-cones) march from cell to cell"
+            );
+        }
         let cones = ConeSettings {
             bounces: self.bounces.or(scene.bounces).unwrap_or(d.bounces),
             indirect_scale: self.indirect_scale.or(scene.indirect_scale),
@@ -194,9 +223,7 @@ impl VctArgs {
             wide_steps_by_level: self.wide_steps_by_level
                 || scene.wide_steps_by_level.unwrap_or(d.wide_steps_by_level),
             cosine_cones: self.cosine_cones || scene.cosine_cones.unwrap_or(d.cosine_cones),
-            snapped_cones: self.snapped_cones
-                || scene.snapped_cones.unwrap_or(d.snapped_cones)
-                || lattice_cones > 0,
+            snapped_cones,
             lattice_cones,
             accumulate_bounces: !self.no_accumulate,
             shadow_aperture_deg: self
