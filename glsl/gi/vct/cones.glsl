@@ -124,6 +124,24 @@ float grid_exit(vec3 a, vec3 b) {
 // sessions 10 and 11).
 const float GRID_FACE_PATH = 0.65;
 
+// One sample `s` of a cone's march, its opacity filtered for a path of one footprint,
+// composited behind `acc` for a path of `footprints`; with `ao_volume` (0..5), the
+// ambient occlusion's own opacity from that volume at `uvw`, weighted down with the
+// distance `dist` (trace_cone).
+void composite(vec4 s, float footprints, int ao_volume, vec3 uvw, float lod, float dist, inout vec4 acc,
+               inout float ao, inout float ao_alpha) {
+    float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), footprints);
+    vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
+    acc.rgb += (1.0 - acc.a) * rgb;
+    acc.a += (1.0 - acc.a) * a;
+    if (ao_volume >= 0) {
+        float o = sample_directional(ao_volume, uvw, max(lod - 1.0, 0.0)).a;
+        o = 1.0 - pow(1.0 - clamp(o, 0.0, 0.9999), footprints);
+        ao += (1.0 - ao_alpha) * o / (1.0 + dist / vct.ao_distance);
+        ao_alpha += (1.0 - ao_alpha) * o;
+    }
+}
+
 // The whole level a snapped cone reads at `dist` along its axis, `height` above its
 // surface's plane (march_cells), at most `top`.
 float snapped_level(float dist, float tan_half, float height, bool clear, float min_lod, float top) {
@@ -209,16 +227,7 @@ vec4 march_cells(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surf
         // Cones that never read the base level (min_lod >= 1, the diffuse ones) skip its
         // fetches: the branch is on a constant once inlined.
         vec4 s = min_lod >= 1.0 ? sample_directional_volumes(uvw, dir, lod - 1.0) : sample_voxels(uvw, dir, lod);
-        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), footprints);
-        vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
-        acc.rgb += (1.0 - acc.a) * rgb;
-        acc.a += (1.0 - acc.a) * a;
-        if (ao_volume >= 0) {
-            float o = sample_directional(ao_volume, uvw, max(lod - 1.0, 0.0)).a;
-            o = 1.0 - pow(1.0 - clamp(o, 0.0, 0.9999), footprints);
-            ao += (1.0 - ao_alpha) * o / (1.0 + dist / vct.ao_distance);
-            ao_alpha += (1.0 - ao_alpha) * o;
-        }
+        composite(s, footprints, ao_volume, uvw, lod, dist, acc, ao, ao_alpha);
         if (at_face) {
             break;
         }
@@ -297,16 +306,7 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surfa
         float exit_fraction = leaving ? grid_exit(uvw, next_uvw) : 1.0;
         float path = distance(next_uvw, uvw) * vct.origin.w * float(vct.resolution) * exit_fraction;
         float footprints = at_face ? GRID_FACE_PATH : path / footprint;
-        float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), footprints);
-        vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
-        acc.rgb += (1.0 - acc.a) * rgb;
-        acc.a += (1.0 - acc.a) * a;
-        if (ao_volume >= 0) {
-            float o = sample_directional(ao_volume, uvw, max(lod - 1.0, 0.0)).a;
-            o = 1.0 - pow(1.0 - clamp(o, 0.0, 0.9999), footprints);
-            ao += (1.0 - ao_alpha) * o / (1.0 + dist / vct.ao_distance);
-            ao_alpha += (1.0 - ao_alpha) * o;
-        }
+        composite(s, footprints, ao_volume, uvw, lod, dist, acc, ao, ao_alpha);
         if (at_face) {
             break;
         }
