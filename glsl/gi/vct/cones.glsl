@@ -86,7 +86,6 @@ vec4 sample_voxels(vec3 uvw, vec3 dir, float lod) {
 // bends the ring cones too far, and lifting every sample a whole cone diameter bends the
 // slanted cones towards the normal, far off their axis (BENCHMARKS.md, the dense grid's
 // quality history).
-
 vec3 cone_sample(vec3 origin, vec3 dir, float dist, float tan_half, float min_lod, vec3 surface, vec3 n,
                  out float lod, out float diameter, out float footprint) {
     float voxel = vct.origin.w;
@@ -195,18 +194,23 @@ vec4 march_cells(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surf
     float voxel = vct.origin.w;
     float cells = float(vct.resolution);
     float top = float(vct.directional_levels);
-    bool clear = dot(dir, n) < 0.9;
+    float rise = dot(dir, n);
+    float start_height = dot(origin - surface, n);
+    bool clear = rise < 0.9;
     vec3 m = abs(dir);
     int dominant = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
     // Where the axis starts, in voxels from the grid's corner; 1/dir per axis, huge
-    // where the axis runs along the faces.
+    // where the axis runs along the faces; which faces the axis leaves cells by, and the
+    // nudge that puts a point on a face into the cell ahead.
     vec3 start = (origin - vct.origin.xyz) / voxel;
     vec3 inv = 1.0 / mix(vec3(1e-9), dir, greaterThan(m, vec3(1e-9)));
+    vec3 ahead = step(0.0, dir);
+    vec3 nudge = (2.0 * ahead - 1.0) * 1e-4;
     vec4 acc = vec4(0.0);
     float ao = 0.0;
     float ao_alpha = 0.0;
     float dist = voxel;
-    float lod = snapped_level(dist, tan_half, dot(dir, n) * dist + dot(origin - surface, n), clear, min_lod, top);
+    float lod = snapped_level(dist, tan_half, rise * dist + start_height, clear, min_lod, top);
     bool at_face = false;
     vec3 p = start + dir * (dist / voxel);
     while (acc.a < 0.99 && dist < vct.max_distance && all(greaterThanEqual(p, vec3(0.0))) &&
@@ -214,8 +218,7 @@ vec4 march_cells(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surf
         float cell = exp2(lod);
         vec3 q = p / cell;
         // The cell the axis enters at p (on a face, the one ahead), and its exit face.
-        vec3 ahead = step(0.0, dir);
-        vec3 face = floor(q + (2.0 * ahead - 1.0) * 1e-4) + ahead;
+        vec3 face = floor(q + nudge) + ahead;
         vec3 t3 = (face - q) * inv;
         float chord = max(min(t3.x, min(t3.y, t3.z)), 1e-4);
         int exit_axis = t3.x <= t3.y && t3.x <= t3.z ? 0 : (t3.y <= t3.z ? 1 : 2);
@@ -241,7 +244,7 @@ vec4 march_cells(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surf
             lod = max(lod - 1.0, min_lod);
             continue;
         }
-        float want = snapped_level(dist, tan_half, dot(dir, n) * dist + dot(origin - surface, n), clear, min_lod, top);
+        float want = snapped_level(dist, tan_half, rise * dist + start_height, clear, min_lod, top);
         if (want < lod) {
             lod = want;
         }
