@@ -860,6 +860,18 @@ gpu_layout! {
         uint cone_cosine,
     }
 
+    /// Push constants of cone tracing: the lattice cones (`--lattice-cones`) this dispatch traces; the first dispatch also traces every other cone of the pass.
+    struct ConeTracePush {
+        /// The first lattice cone of this dispatch: 0 starts the gather afresh, later dispatches add to what the ones before left in `BINDING_SCREEN_INDIRECT`.
+        uint first_cone,
+        /// Lattice cones this dispatch traces.
+        uint cone_count,
+        /// Unused.
+        uint pad0,
+        /// Unused.
+        uint pad1,
+    }
+
     /// Push constants of the path tracer: this dispatch's share of the samples.
     struct PathPush {
         /// Samples already in `BINDING_PATH_MEAN`: 0 starts afresh.

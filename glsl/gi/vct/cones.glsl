@@ -471,22 +471,38 @@ vec4 trace_ring_cone(vec3 origin, vec3 dir, int parts, float min_lod, vec3 surfa
 // directions), up to a cosine of 0.2. The cones near the normal must stay within 17
 // degrees, as the sub-cones that keep a closed room closed: at 72 cones they are 16.8
 // degrees; 48 (20.5 degrees) let a tenth of a closed box's light out.
+// The screen's gather only: the voxels' bounce keeps the ring, whose light the screen's
+// gather then reads through the lattice. 72 cones from every voxel made a bounce at 256^3
+// take 25 s in one dispatch on lavapipe, which crashed when other work shared its cores.
+// Returns cones first..first + count - 1's share of the mean (rgb radiance, a occlusion),
+// so that the gather may be split over dispatches (cone_trace.rs says why).
 layout(constant_id = SPEC_LATTICE_CONES) const uint LATTICE_CONES = 0u;
 
-vec4 gather_lattice(vec3 surface, vec3 origin, vec3 n, float min_lod, int ao_volume) {
-    int count = int(LATTICE_CONES);
+vec4 gather_lattice(vec3 surface, vec3 origin, vec3 n, float min_lod, int ao_volume, int first, int count) {
+    int total = int(LATTICE_CONES);
     vec3 t = perpendicular(n);
     vec3 b = cross(n, t);
-    float spacing = sqrt(3.14159265 / float(count));
+    float spacing = sqrt(3.14159265 / float(total));
     vec4 sum = vec4(0.0);
-    for (int i = 0; i < count; i++) {
-        float r = sqrt((float(i) + 0.5) / float(count));
+    for (int i = first; i < first + count; i++) {
+        float r = sqrt((float(i) + 0.5) / float(total));
         float phi = float(i) * 2.39996323;
         vec3 d = normalize(r * cos(phi) * t + r * sin(phi) * b + sqrt(max(1.0 - r * r, 0.0)) * n);
         float tan_half = tan(1.41421356 * spacing / sqrt(max(dot(d, n), 0.2)));
         sum += march_cells(origin, d, tan_half, min_lod, surface, n, ao_volume);
     }
-    return sum / float(count);
+    return sum / float(total);
+}
+
+// The one directional volume ambient occlusion reads opacity from (trace_cone), or -1
+// without it.
+int ao_volume_facing(vec3 n, bool with_ao) {
+    if (!with_ao) {
+        return -1;
+    }
+    vec3 m = abs(n);
+    int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
+    return 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
 }
 
 // Cosine-weighted mean radiance over the hemisphere around n of the surface at `surface`
@@ -497,21 +513,7 @@ vec4 gather_lattice(vec3 surface, vec3 origin, vec3 n, float min_lod, int ao_vol
 // instead (`--cone`: a component against the path tracer's exact cone integral).
 vec4 gather_diffuse(vec3 surface, vec3 origin, vec3 n, int cones, float min_lod, bool with_ao, float step_factor,
                     bool split_ring, int only) {
-    int ao_volume = -1;
-    if (with_ao) {
-        vec3 m = abs(n);
-        int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
-        ao_volume = 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
-    }
-    // The screen's gather only (`split_ring`): the voxels' bounce keeps the ring, whose
-    // light the screen's gather then reads through the lattice. 72 cones from every voxel
-    // made a bounce at 256³ take 25 s in one dispatch on lavapipe, which crashed when
-    // other work shared its cores. (`--cone` picks a cone of the ring: the lattice has
-    // none.)
-    if (split_ring && LATTICE_CONES > 0u) {
-        vec4 sum = gather_lattice(surface, origin, n, min_lod, ao_volume);
-        return vec4(sum.rgb, 1.0 - sum.a);
-    }
+    int ao_volume = ao_volume_facing(n, with_ao);
     vec3 t = perpendicular(n);
     vec3 b = cross(n, t);
     int ring = cones - 1;

@@ -286,6 +286,11 @@ impl PipelineBase {
         )
     }
 
+    /// The lattice's cones (`SPEC_LATTICE_CONES`; 0: the ring instead).
+    pub fn lattice_cones(&self) -> u32 {
+        self.constants[layout::SPEC_LATTICE_CONES as usize]
+    }
+
     /// For a graphics pipeline's `GraphicsDesc::constants`.
     pub fn constants(&self) -> &[u32] {
         &self.constants

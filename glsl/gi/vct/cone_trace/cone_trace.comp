@@ -17,10 +17,13 @@
 #include "gi/screen/screen.glsl"
 
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
-layout(set = SET_SCREEN, binding = BINDING_SCREEN_INDIRECT, rgba16f) uniform writeonly image2D indirect;
+layout(set = SET_SCREEN, binding = BINDING_SCREEN_INDIRECT, rgba16f) uniform image2D indirect;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_SHADOW, rgba16f) uniform writeonly image2D shadow;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_SPECULAR, rgba16f) uniform writeonly image2D specular;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_TRANSMITTED, rgba16f) uniform writeonly image2D transmitted;
+layout(push_constant) uniform Push {
+    ConeTracePush push;
+};
 
 // Irradiance at the surface point p (normal n) from the sampled emitters, each shadowed by
 // a soft-shadow cone from `origin` along its phi.
@@ -102,12 +105,30 @@ void main() {
     const bool with_ao = false;
 #endif
     vec3 start = p + n * (2.0 * vct.origin.w);
+    bool emitters_alone = frame.debug_view == DEBUG_EMITTER_LIGHT;
+    if (LATTICE_CONES > 0u && push.first_cone > 0u) {
+        // A later share of the lattice (cone_trace.rs says why it is split): added to the
+        // earlier ones', its occlusion taken from alpha (the ambient occlusion).
+        if (!emitters_alone) {
+            vec4 share = gather_lattice(p, start, n, 1.0, ao_volume_facing(n, with_ao), int(push.first_cone),
+                                        int(push.cone_count));
+            imageStore(indirect, low, imageLoad(indirect, low) + vec4(share.rgb, -share.a));
+        }
+        return;
+    }
+    vec4 gathered = vec4(0.0, 0.0, 0.0, 1.0);
+    if (!emitters_alone) {
+        if (LATTICE_CONES > 0u) {
+            vec4 share = gather_lattice(p, start, n, 1.0, ao_volume_facing(n, with_ao), 0, int(push.cone_count));
+            gathered = vec4(share.rgb, 1.0 - share.a);
+        } else {
+            gathered = gather_diffuse(p, start, n, int(vct.diffuse_cones), 1.0, with_ao, vct.step_factor, true,
+                                      int(vct.only_cone));
+        }
+    }
     // The sampled emitters' light, which the voxels do not hold, joins the gathered
     // radiance as the cosine-weighted mean it adds: E / pi (not with `--cone`, a cone's
     // gather alone; alone in its debug view).
-    bool emitters_alone = frame.debug_view == DEBUG_EMITTER_LIGHT;
-    vec4 gathered = emitters_alone ? vec4(0.0, 0.0, 0.0, 1.0)
-                                   : gather_diffuse(p, start, n, int(vct.diffuse_cones), 1.0, with_ao, vct.step_factor, true, int(vct.only_cone));
     if (vct.only_cone == 0xffffffffu) {
         gathered.rgb += sampled_emitter_light(p, start, n) / PI;
     }
