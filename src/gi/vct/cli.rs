@@ -73,7 +73,7 @@ pub struct VctArgs {
     /// cosine-weighted hemisphere (a Fibonacci lattice), 32 to 256 (0: off), each counting 1/N,
     /// instead of the ring of --diffuse-cones (the voxel bounce keeps the ring); implies
     /// --snapped-cones, and 72 keeps a closed room closed. The image converges as the
-    /// voxels get finer, at 4.3 times the default cone_trace on lavapipe [default: off].
+    /// voxels get finer, at about 4.5 times the default cone_trace on lavapipe [default: off].
     #[arg(long)]
     pub lattice_cones: Option<u32>,
     /// Trace the cones (indirect light, soft shadows, specular, refraction) on one pixel of
