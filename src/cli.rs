@@ -771,6 +771,44 @@ mod tests {
         }
     }
 
+    /// Switching to the lattice (or to snapped cones) from the settings panel, with the
+    /// ring's and the steps' options set before, drops them rather than being refused.
+    #[test]
+    fn switching_the_layout_drops_what_it_ignores() {
+        let mut args = match Cli::try_parse_from([
+            "voxcone",
+            "render",
+            "--diffuse-cones",
+            "9",
+            "--cosine-cones",
+            "--step-factor",
+            "0.3",
+            "--bounce-step-factor",
+            "0.4",
+            "--wide-steps-by-level",
+        ])
+        .unwrap()
+        .command
+        {
+            Some(Command::Render(r)) => r.common,
+            _ => unreachable!(),
+        };
+        args.vct.lattice_cones = Some(72);
+        assert!(args.render_settings(&GiOverrides::default()).is_err());
+        args.vct.drop_ignored_by(true, true);
+        let gi = cone_tracing(args.render_settings(&GiOverrides::default()).unwrap());
+        assert_eq!(gi.cones.lattice_cones, 72);
+        args.vct.lattice_cones = Some(0);
+        args.vct.snapped_cones = true;
+        args.vct.diffuse_cones = Some(9);
+        args.vct.step_factor = Some(0.3);
+        assert!(args.render_settings(&GiOverrides::default()).is_err());
+        args.vct.drop_ignored_by(true, false);
+        let gi = cone_tracing(args.render_settings(&GiOverrides::default()).unwrap());
+        assert_eq!(gi.cones.diffuse_cones, 9);
+        assert!(gi.cones.snapped_cones);
+    }
+
     #[test]
     fn each_kind_of_cone_takes_its_own_step() {
         let scene = GiOverrides {

@@ -430,12 +430,22 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             let mut scale = vct.cones.indirect_scale.unwrap_or(0);
             let mut shadow_cones = vct.shadow_cones;
             let octree = view.args.gi == GiMode::Octree;
-            settle(ui.add(egui::Slider::new(&mut cones, 1..=16).text("diffuse cones")));
+            // What the cone layout in use ignores is shown, not offered (cli.rs refuses it).
+            let (snapped_now, lattice_now) =
+                (vct.cones.snapped_cones, vct.cones.lattice_cones != 0);
+            settle(ui.add_enabled(
+                !lattice_now,
+                egui::Slider::new(&mut cones, 1..=16).text("diffuse cones"),
+            ));
             settle(ui.add(egui::Slider::new(&mut aperture, 10.0..=120.0).text("aperture (deg)")));
-            settle(ui.add(egui::Slider::new(&mut step, 0.1..=1.0).text("step factor")));
-            settle(
-                ui.add(egui::Slider::new(&mut bounce_step, 0.1..=1.0).text("bounce step factor")),
-            );
+            settle(ui.add_enabled(
+                !snapped_now,
+                egui::Slider::new(&mut step, 0.1..=1.0).text("step factor"),
+            ));
+            settle(ui.add_enabled(
+                !snapped_now,
+                egui::Slider::new(&mut bounce_step, 0.1..=1.0).text("bounce step factor"),
+            ));
             settle(ui.add(egui::Slider::new(&mut bounces, 1..=8).text("bounces")));
             settle(
                 ui.add(egui::Slider::new(&mut scale, 0..=8).text("indirect scale"))
@@ -471,8 +481,14 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             let mut accumulate = vct.cones.accumulate_bounces;
             let mut full_update = vct.full_update;
             let mut voxelizer = vct.voxelizer;
-            settle(ui.checkbox(&mut wide, "wide steps by level"));
-            settle(ui.checkbox(&mut cosine, "cosine-weighted cones"));
+            settle(ui.add_enabled(
+                !snapped_now,
+                egui::Checkbox::new(&mut wide, "wide steps by level"),
+            ));
+            settle(ui.add_enabled(
+                !lattice_now,
+                egui::Checkbox::new(&mut cosine, "cosine-weighted cones"),
+            ));
             settle(ui.checkbox(&mut snapped, "snapped cones"));
             settle(ui.checkbox(&mut lattice, format!("lattice of {LATTICE_CONES} cones")));
             settle(ui.checkbox(&mut accumulate, "accumulate bounces over frames"));
@@ -532,6 +548,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                 args.indirect_scale = (scale > 0).then_some(scale);
             }
             args.shadow_cones = shadow_cones;
+            args.drop_ignored_by(snapped, lattice);
         }
         GiSettings::Path(path) => {
             let mut spp = path.spp;

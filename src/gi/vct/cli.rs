@@ -150,6 +150,21 @@ impl VctArgs {
 
     /// The cone tracer's settings in `store` (`octree`: the octree, else the dense grid):
     /// the command line over the scene file's `[gi]` over the defaults.
+    /// Drops the options that snapped cones (`snapped`) and the lattice (`lattice`) would
+    /// ignore and so refuse (`settings`): the settings panel switching the layout, which
+    /// must not be left with a refusal its sliders cannot undo.
+    pub fn drop_ignored_by(&mut self, snapped: bool, lattice: bool) {
+        if snapped || lattice {
+            self.step_factor = None;
+            self.bounce_step_factor = None;
+            self.wide_steps_by_level = false;
+        }
+        if lattice {
+            self.diffuse_cones = None;
+            self.cosine_cones = false;
+        }
+    }
+
     pub fn settings(&self, octree: bool, scene: &GiOverrides) -> Result<VctSettings> {
         let d = ConeSettings::default();
         let lattice_cones = self
