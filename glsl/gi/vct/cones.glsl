@@ -123,6 +123,11 @@ float grid_exit(vec3 a, vec3 b) {
 // sessions 10 and 11).
 const float GRID_FACE_PATH = 0.65;
 
+// The axis along which `m` (non-negative) is largest, x before y before z on ties.
+int major_axis(vec3 m) {
+    return m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
+}
+
 // One sample `s` of a cone's march, its opacity filtered for a path of one footprint,
 // composited behind `acc` for a path of `footprints`; with `ao_volume` (0..5), the
 // ambient occlusion's own opacity from that volume at `uvw`, weighted down with the
@@ -198,7 +203,7 @@ vec4 march_cells(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surf
     float start_height = dot(origin - surface, n);
     bool clear = rise < 0.9;
     vec3 m = abs(dir);
-    int dominant = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
+    int dominant = major_axis(m);
     // Where the axis starts, in voxels from the grid's corner; 1/dir per axis, huge
     // where the axis runs along the faces; which faces the axis leaves cells by, and the
     // nudge that puts a point on a face into the cell ahead.
@@ -500,8 +505,7 @@ int ao_volume_facing(vec3 n, bool with_ao) {
     if (!with_ao) {
         return -1;
     }
-    vec3 m = abs(n);
-    int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
+    int axis = major_axis(abs(n));
     return 2 * axis + (n[axis] >= 0.0 ? 0 : 1);
 }
 

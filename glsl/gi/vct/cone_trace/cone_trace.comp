@@ -106,25 +106,24 @@ void main() {
 #endif
     vec3 start = p + n * (2.0 * vct.origin.w);
     bool emitters_alone = frame.debug_view == DEBUG_EMITTER_LIGHT;
-    if (LATTICE_CONES > 0u && push.first_cone > 0u) {
-        // A later share of the lattice (cone_trace.rs says why it is split): added to the
-        // earlier ones', its occlusion taken from alpha (the ambient occlusion).
-        if (!emitters_alone) {
-            vec4 share = gather_lattice(p, start, n, 1.0, ao_volume_facing(n, with_ao), int(push.first_cone),
-                                        int(push.cone_count));
-            imageStore(indirect, low, imageLoad(indirect, low) + vec4(share.rgb, -share.a));
-        }
-        return;
-    }
-    vec4 gathered = vec4(0.0, 0.0, 0.0, 1.0);
+    // A later share of the lattice (cone_trace.rs says why it is split) adds to the
+    // earlier ones', its occlusion taken from alpha (the ambient occlusion). One call
+    // site per kind of gather: each is inlined.
+    bool later_share = LATTICE_CONES > 0u && push.first_cone > 0u;
+    vec4 gathered = later_share ? imageLoad(indirect, low) : vec4(0.0, 0.0, 0.0, 1.0);
     if (!emitters_alone) {
         if (LATTICE_CONES > 0u) {
-            vec4 share = gather_lattice(p, start, n, 1.0, ao_volume_facing(n, with_ao), 0, int(push.cone_count));
-            gathered = vec4(share.rgb, 1.0 - share.a);
+            vec4 share = gather_lattice(p, start, n, 1.0, ao_volume_facing(n, with_ao), int(push.first_cone),
+                                        int(push.cone_count));
+            gathered += vec4(share.rgb, -share.a);
         } else {
             gathered = gather_diffuse(p, start, n, int(vct.diffuse_cones), 1.0, with_ao, vct.step_factor, true,
                                       int(vct.only_cone));
         }
+    }
+    if (later_share) {
+        imageStore(indirect, low, gathered);
+        return;
     }
     // The sampled emitters' light, which the voxels do not hold, joins the gathered
     // radiance as the cosine-weighted mean it adds: E / pi (not with `--cone`, a cone's
