@@ -533,7 +533,7 @@ fn write_builtin_scene(dir: &std::path::Path) -> std::io::Result<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gi::vct::{ConeSettings, Resolution, VctSettings};
+    use crate::gi::vct::{ConeSettings, DirectionalFilter, Resolution, Store, VctSettings};
 
     fn cone_tracing(settings: RenderSettings) -> VctSettings {
         match settings.gi {
@@ -807,6 +807,32 @@ mod tests {
         let gi = cone_tracing(args.render_settings(&GiOverrides::default()).unwrap());
         assert_eq!(gi.cones.diffuse_cones, 9);
         assert!(gi.cones.snapped_cones);
+    }
+
+    #[test]
+    fn rows_filter_the_dense_grid_only() {
+        let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
+            Some(Command::Render(r)) => r.common.render_settings(&GiOverrides::default()),
+            _ => unreachable!(),
+        };
+        let gi =
+            cone_tracing(parse(&["voxcone", "render", "--directional-filter", "rows"]).unwrap());
+        assert_eq!(
+            gi.store,
+            Store::Dense {
+                filter: DirectionalFilter::Rows
+            }
+        );
+        let octree = [
+            "voxcone",
+            "render",
+            "--gi",
+            "octree",
+            "--directional-filter",
+            "rows",
+        ];
+        let error = parse(&octree).unwrap_err().to_string();
+        assert!(error.contains("needs --gi dense"), "{error}");
     }
 
     #[test]

@@ -142,6 +142,10 @@ gpu_layout! {
         BINDING_FILTER_DST = 2;
         /// Dense filter pass (its own set 2, one per level): the voxel normals, oriented to the lit side by injection.
         BINDING_FILTER_NORMAL = 3;
+        /// Dense filter pass by rows (`--directional-filter rows`): the rows of the level below, each composited along the direction's axis, `rgba16f` storage (`glsl/gi/vct/dense/filter_rows.comp`).
+        BINDING_FILTER_ROWS_SRC = 4;
+        /// Dense filter pass by rows: the rows of the level written, `rgba16f` storage.
+        BINDING_FILTER_ROWS_DST = 5;
         /// Workgroup edge of the 3D compute passes.
         VOXEL_GROUP_SIZE = 4;
 
@@ -858,6 +862,14 @@ gpu_layout! {
         float cone_cos_half,
         /// 1: the cone component weighs its rays by the cosine to the normal, as `--cosine-cones` weighs the gather's cones; 0: their plain mean.
         uint cone_cosine,
+    }
+
+    /// Push constants of the dense grid's filter by rows: one level of one direction per dispatch.
+    struct FilterRowsPush {
+        /// The directional level written: 0 is the first above the base, each cell 2 << level voxels wide.
+        uint level,
+        /// The direction filtered, 0..5: +X -X +Y -Y +Z -Z.
+        uint direction,
     }
 
     /// Push constants of cone tracing: the lattice cones (`--lattice-cones`) this dispatch traces; the first dispatch also traces every other cone of the pass.

@@ -25,7 +25,7 @@ use crate::gi::path::cli::PathArgs;
 use crate::gi::probes::cli::{ProbeArgs, Switch};
 use crate::gi::vct::cli::VctArgs;
 use crate::gi::vct::voxelize::Voxelizer;
-use crate::gi::vct::{CPU_VOXELS, LATTICE_CONES};
+use crate::gi::vct::{DirectionalFilter, Store, CPU_VOXELS, LATTICE_CONES};
 use crate::gi::{DebugView, GiSettings};
 use crate::renderer::{Renderer, FRAMES_IN_FLIGHT};
 use crate::scene::{Light, LightKind};
@@ -397,7 +397,7 @@ fn switch_technique(args: &mut CommonArgs, mode: GiMode) {
     args.gi = mode;
     match mode {
         GiMode::Dense => args.vct.octree_depth = None,
-        GiMode::Octree => {}
+        GiMode::Octree => args.vct.directional_filter = DirectionalFilter::Pairs,
         GiMode::Off | GiMode::Path | GiMode::Probes => args.vct = VctArgs::default(),
     }
     if mode != GiMode::Path {
@@ -481,6 +481,12 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             let mut accumulate = vct.cones.accumulate_bounces;
             let mut full_update = vct.full_update;
             let mut voxelizer = vct.voxelizer;
+            let mut rows = matches!(
+                vct.store,
+                Store::Dense {
+                    filter: DirectionalFilter::Rows
+                }
+            );
             settle(ui.add_enabled(
                 !snapped_now,
                 egui::Checkbox::new(&mut wide, "wide steps by level"),
@@ -493,6 +499,16 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             settle(ui.checkbox(&mut lattice, format!("lattice of {LATTICE_CONES} cones")));
             settle(ui.checkbox(&mut accumulate, "accumulate bounces over frames"));
             settle(ui.checkbox(&mut full_update, "voxelize everything every frame"));
+            settle(
+                ui.add_enabled(
+                    !octree,
+                    egui::Checkbox::new(&mut rows, "directional levels by rows"),
+                )
+                .on_hover_text(
+                    "each row of voxels composited whole along the axis, then the rows \
+                     averaged (the dense grid only); off: children in pairs",
+                ),
+            );
             egui::ComboBox::from_label("voxelizer")
                 .selected_text(format!("{voxelizer:?}"))
                 .show_ui(ui, |ui| {
@@ -508,6 +524,11 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             }
             args.no_accumulate = !accumulate;
             args.full_update = full_update;
+            args.directional_filter = if rows {
+                DirectionalFilter::Rows
+            } else {
+                DirectionalFilter::Pairs
+            };
             if voxelizer != vct.voxelizer {
                 args.voxelizer = voxelizer;
             }

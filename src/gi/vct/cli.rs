@@ -6,8 +6,8 @@ use clap::Args;
 use super::octree::check_depth;
 use super::voxelize::Voxelizer;
 use super::{
-    check_voxel_size, check_voxels, ConeSettings, Resolution, Store, VctSettings,
-    DEFAULT_SAMPLED_EMITTERS,
+    check_voxel_size, check_voxels, ConeSettings, DirectionalFilter, Resolution, Store,
+    VctSettings, DEFAULT_SAMPLED_EMITTERS,
 };
 use crate::scene::GiOverrides;
 
@@ -115,6 +115,9 @@ pub struct VctArgs {
     /// How the scene is voxelized (both cover the same voxels)
     #[arg(long, value_enum, default_value_t)]
     pub voxelizer: Voxelizer,
+    /// How the dense grid's directional levels are filtered from the voxels
+    #[arg(long, value_enum, default_value_t)]
+    pub directional_filter: DirectionalFilter,
 }
 
 impl VctArgs {
@@ -141,6 +144,10 @@ impl VctArgs {
             (self.shadow_aperture.is_some(), "--shadow-aperture"),
             (self.ao_distance.is_some(), "--ao-distance"),
             (self.voxelizer != Voxelizer::Auto, "--voxelizer"),
+            (
+                self.directional_filter != DirectionalFilter::Pairs,
+                "--directional-filter",
+            ),
             (self.sampled_emitters.is_some(), "--sampled-emitters"),
         ]
         .into_iter()
@@ -269,10 +276,17 @@ impl VctArgs {
         if let Resolution::Auto { size: Some(size) } = voxels {
             check_voxel_size(size)?;
         }
-        let store = if octree {
-            Store::Octree { capacities: None }
-        } else {
-            Store::Dense
+        let filter = self.directional_filter;
+        let store = match (octree, filter) {
+            (true, DirectionalFilter::Pairs) => Store::Octree { capacities: None },
+            // The octree's bricks are filtered from their children's bricks, which keep no
+            // rows (BENCHMARKS.md, session 37).
+            (true, DirectionalFilter::Rows) => {
+                bail!(
+                    "--directional-filter rows needs --gi dense: the octree filters by pairs only"
+                )
+            }
+            (false, filter) => Store::Dense { filter },
         };
         let voxels = match (octree, self.octree_depth, voxels) {
             (true, Some(depth), _) => {

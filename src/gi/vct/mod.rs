@@ -30,8 +30,9 @@ pub use self::dense::Dense;
 pub use self::grid::Grid;
 pub use self::octree::Octree;
 pub use self::settings::{
-    auto_indirect_scale, auto_voxels, check_voxel_size, check_voxels, ConeSettings, Resolution,
-    Store, VctSettings, CPU_VOXELS, DEFAULT_SAMPLED_EMITTERS, GPU_VOXELS, LATTICE_CONES,
+    auto_indirect_scale, auto_voxels, check_voxel_size, check_voxels, ConeSettings,
+    DirectionalFilter, Resolution, Store, VctSettings, CPU_VOXELS, DEFAULT_SAMPLED_EMITTERS,
+    GPU_VOXELS, LATTICE_CONES,
 };
 use super::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
@@ -300,7 +301,7 @@ impl PipelineBase {
 /// Creates the cone tracer with the store `settings` asks for.
 pub fn create(inputs: &Inputs, settings: &VctSettings) -> Result<Box<dyn Technique>> {
     Ok(match settings.store {
-        Store::Dense => Box::new(ConeTracing::<Dense>::new(inputs, settings)?),
+        Store::Dense { .. } => Box::new(ConeTracing::<Dense>::new(inputs, settings)?),
         Store::Octree { .. } => Box::new(ConeTracing::<Octree>::new(inputs, settings)?),
     })
 }

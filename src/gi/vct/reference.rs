@@ -170,6 +170,53 @@ pub fn filter_directional(level: &[[f32; 4]], n: u32, direction: usize) -> Vec<[
     out
 }
 
+/// `--directional-filter rows` by its definition: the cells `width` voxels wide (a power
+/// of two dividing `n`) of the base `voxels` (each as seen along `direction`, `n`³), each
+/// cell's rows of voxels along the direction's axis composited front to back, then
+/// averaged.
+pub fn filter_rows(voxels: &[[f32; 4]], n: u32, width: u32, direction: usize) -> Vec<[f32; 4]> {
+    assert_eq!(
+        voxels.len(),
+        (n as usize).pow(3),
+        "voxels for resolution {n}"
+    );
+    assert!(
+        width.is_power_of_two() && n % width == 0,
+        "cells of {width} in {n}"
+    );
+    let axis = direction / 2;
+    let others = [(axis + 1) % 3, (axis + 2) % 3];
+    let m = n / width;
+    let mut out = Vec::with_capacity((m as usize).pow(3));
+    for k in 0..m {
+        for j in 0..m {
+            for i in 0..m {
+                let corner = width * UVec3::new(i, j, k);
+                let mut sum = [0.0; 4];
+                for v in 0..width {
+                    for u in 0..width {
+                        let mut row = [0.0; 4];
+                        for t in 0..width {
+                            // Travelling towards +, a cone meets the lower coordinate first.
+                            let along = if direction % 2 == 0 { t } else { width - 1 - t };
+                            let mut voxel = corner;
+                            voxel[axis] += along;
+                            voxel[others[0]] += u;
+                            voxel[others[1]] += v;
+                            row = over(row, voxels[linear(n, voxel)]);
+                        }
+                        for (s, c) in sum.iter_mut().zip(row) {
+                            *s += c;
+                        }
+                    }
+                }
+                out.push(sum.map(|s| s / (width * width) as f32));
+            }
+        }
+    }
+    out
+}
+
 /// Every triangle of `scene` at time 0, in world space.
 pub fn world_triangles(scene: &crate::scene::Scene) -> Vec<[Vec3; 3]> {
     world_triangles_where(scene, |_| true)

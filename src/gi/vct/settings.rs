@@ -12,12 +12,29 @@ use crate::vk::Context;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Store {
     /// A dense grid in 3D textures (`--gi dense`).
-    Dense,
+    Dense {
+        /// How its directional levels are filtered.
+        filter: DirectionalFilter,
+    },
     /// A sparse voxel octree of the same effective resolution (`--gi octree`).
     Octree {
         /// Pool sizes to start from instead of the estimate from the scene.
         capacities: Option<Capacities>,
     },
+}
+
+/// How each directional level's cells are filtered from the voxels below them
+/// (`--directional-filter`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum DirectionalFilter {
+    /// From the level below, its 2x2x2 children composited in pairs along the axis and
+    /// the pairs averaged (Crassin 2011): as if what lies behind were uncorrelated with
+    /// what lies in front, so a surface seen edge-on comes out more opaque than its voxels
+    #[default]
+    Pairs,
+    /// Every row of voxels along the axis composited whole, then the rows averaged: what
+    /// rays along the axis see of the voxels. The dense grid only
+    Rows,
 }
 
 /// Voxels per axis (a power of two): of the dense grid, or effective of the octree.

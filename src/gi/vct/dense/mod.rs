@@ -15,8 +15,8 @@ use ash::vk;
 
 use super::voxelize::{self, Meshes, VoxelizePass};
 use super::{
-    bind_cone_samples, directional_levels, Grid, PipelineBase, Preparation, StoreShaders,
-    VctSettings, VoxelStore, Voxels,
+    bind_cone_samples, directional_levels, DirectionalFilter, Grid, PipelineBase, Preparation,
+    Store, StoreShaders, VctSettings, VoxelStore, Voxels,
 };
 use crate::gi::DebugView;
 use crate::gpu_layout::{self as layout, InjectPush};
@@ -188,6 +188,10 @@ impl VoxelStore for Dense {
     ) -> Result<Self> {
         let (resolution, full_update) = (grid.resolution, settings.full_update);
         let voxelizer = settings.voxelizer;
+        let filter = match settings.store {
+            Store::Dense { filter } => filter,
+            Store::Octree { .. } => DirectionalFilter::Pairs,
+        };
         let volumes = Volumes::new(ctx, resolution, dense_keeps_static_sums(scene, full_update))?;
         let writer = SetWriter::new(ctx, set)
             .storage_image(layout::BINDING_VCT_ALBEDO, volumes.albedo.view)
@@ -244,7 +248,13 @@ impl VoxelStore for Dense {
                 crate::vk::shaders::GI_VCT_VOXELIZE_VOXELIZE_COMP,
                 base,
             )?,
-            filter: filter::FilterPass::new(ctx, [base.sets[0], base.sets[1]], &volumes)?,
+            filter: filter::FilterPass::new(
+                ctx,
+                [base.sets[0], base.sets[1]],
+                &volumes,
+                filter,
+                resolution,
+            )?,
             compact,
             volumes,
             full_update,
@@ -371,6 +381,7 @@ impl VoxelStore for Dense {
     fn memory_bytes(&self) -> Vec<(&'static str, u64)> {
         let mut bytes = self.volumes.bytes();
         bytes.push(("voxel_list", self.compact.list.size));
+        bytes.push(("voxel_filter_rows", self.filter.memory_bytes()));
         bytes
     }
 

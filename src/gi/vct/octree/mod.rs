@@ -193,7 +193,7 @@ impl VoxelStore for Octree {
         check_depth(depth)?;
         let capacities = match settings.store {
             Store::Octree { capacities } => capacities,
-            Store::Dense => None,
+            Store::Dense { .. } => None,
         };
         let full_update = settings.full_update;
         let voxelizer = settings.voxelizer;
