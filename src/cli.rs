@@ -9,7 +9,7 @@ use crate::gi::path::cli::PathArgs;
 use crate::gi::path::ConeComponent;
 use crate::gi::probes::cli::ProbeArgs;
 use crate::gi::vct::cli::VctArgs;
-use crate::gi::vct::ConeSettings;
+use crate::gi::vct::{ConeSettings, Quality};
 use crate::gi::{DebugView, GiSettings};
 use crate::passes::shadow::ShadowResolution;
 use crate::scene::{GiOverrides, LoadOptions, Scene};
@@ -374,8 +374,11 @@ impl CommonArgs {
     }
 
     /// The settings of a frame: the command line over the scene file's `[gi]` over the
-    /// defaults.
-    pub fn render_settings(&self, scene: &GiOverrides) -> Result<RenderSettings> {
+    /// defaults, the cone tracer's those of `quality` unless `--quality` or the scene file
+    /// says otherwise (`render` asks for [`Quality::Accurate`], `view` and `bench` for
+    /// [`Quality::Fast`]).
+    pub fn render_settings(&self, scene: &GiOverrides, quality: Quality) -> Result<RenderSettings> {
+        let quality = self.vct.quality.or(scene.quality).unwrap_or(quality);
         let options = self.load_options();
         if self.vct.octree_depth.is_some() && self.gi != GiMode::Octree {
             bail!("--octree-depth sets the sparse voxel octree: it needs --gi octree");
@@ -413,7 +416,9 @@ impl CommonArgs {
                 if !octree && self.debug_view == DebugView::OctreeNodes {
                     bail!("--debug-view octree-nodes shows the octree: it needs --gi octree");
                 }
-                let mut settings = self.vct.settings(octree, scene)?;
+                let mut settings =
+                    self.vct
+                        .settings(octree, scene, quality, self.cone.is_some())?;
                 settings.cones.only_cone = self.cone_component(&settings.cones)?;
                 GiSettings::ConeTracing(settings)
             }
@@ -423,7 +428,7 @@ impl CommonArgs {
                 if self.cone.is_some() {
                     // The gather's layout as the cone tracer's settings give it (the
                     // scene file's [gi] over the defaults).
-                    let cones = self.vct.settings(false, scene)?.cones;
+                    let cones = self.vct.settings(false, scene, quality, true)?.cones;
                     settings.cone = self.cone_component(&cones)?.map(|index| ConeComponent {
                         index,
                         ring: cones.diffuse_cones - 1,
@@ -533,7 +538,9 @@ fn write_builtin_scene(dir: &std::path::Path) -> std::io::Result<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gi::vct::{ConeSettings, DirectionalFilter, Resolution, Store, VctSettings};
+    use crate::gi::vct::{
+        ConeSettings, DirectionalFilter, Resolution, Store, VctSettings, LATTICE_CONES,
+    };
 
     fn cone_tracing(settings: RenderSettings) -> VctSettings {
         match settings.gi {
@@ -616,7 +623,9 @@ mod tests {
             ..Default::default()
         };
         let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-            Some(Command::Render(r)) => r.common.render_settings(&scene).unwrap(),
+            Some(Command::Render(r)) => {
+                r.common.render_settings(&scene, Quality::Accurate).unwrap()
+            }
             _ => unreachable!(),
         };
         let gi = cone_tracing(parse(&["voxcone", "render"]));
@@ -646,7 +655,10 @@ mod tests {
     fn voxels_come_from_a_count_a_size_or_the_device() {
         let parse =
             |scene: GiOverrides, args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-                Some(Command::Render(r)) => r.common.render_settings(&scene).map(cone_tracing),
+                Some(Command::Render(r)) => r
+                    .common
+                    .render_settings(&scene, Quality::Accurate)
+                    .map(cone_tracing),
                 _ => unreachable!(),
             };
         let none = GiOverrides::default();
@@ -654,7 +666,10 @@ mod tests {
             voxel_size: Some(0.5),
             ..Default::default()
         };
-        let auto = |size| Resolution::Auto { size };
+        let auto = |size| Resolution::Auto {
+            size,
+            quality: Quality::Accurate,
+        };
         let voxels = |scene, args: &[&str]| parse(scene, args).unwrap().voxels;
         assert_eq!(voxels(none, &["voxcone", "render"]), auto(None));
         assert_eq!(voxels(sized, &["voxcone", "render"]), auto(Some(0.5)));
@@ -694,7 +709,9 @@ mod tests {
     #[test]
     fn path_cone_takes_the_gathers_layout() {
         let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-            Some(Command::Render(r)) => r.common.render_settings(&GiOverrides::default()),
+            Some(Command::Render(r)) => r
+                .common
+                .render_settings(&GiOverrides::default(), Quality::Accurate),
             _ => unreachable!(),
         };
         let settings = parse(&[
@@ -737,7 +754,9 @@ mod tests {
     #[test]
     fn lattice_replaces_the_ring() {
         let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-            Some(Command::Render(r)) => r.common.render_settings(&GiOverrides::default()),
+            Some(Command::Render(r)) => r
+                .common
+                .render_settings(&GiOverrides::default(), Quality::Accurate),
             _ => unreachable!(),
         };
         let gi = cone_tracing(parse(&["voxcone", "render", "--lattice-cones", "72"]).unwrap());
@@ -794,25 +813,98 @@ mod tests {
             _ => unreachable!(),
         };
         args.vct.lattice_cones = Some(72);
-        assert!(args.render_settings(&GiOverrides::default()).is_err());
+        assert!(args
+            .render_settings(&GiOverrides::default(), Quality::Accurate)
+            .is_err());
         args.vct.drop_ignored_by(true, true);
-        let gi = cone_tracing(args.render_settings(&GiOverrides::default()).unwrap());
+        let gi = cone_tracing(
+            args.render_settings(&GiOverrides::default(), Quality::Accurate)
+                .unwrap(),
+        );
         assert_eq!(gi.cones.lattice_cones, 72);
         args.vct.lattice_cones = Some(0);
         args.vct.snapped_cones = true;
         args.vct.diffuse_cones = Some(9);
         args.vct.step_factor = Some(0.3);
-        assert!(args.render_settings(&GiOverrides::default()).is_err());
+        assert!(args
+            .render_settings(&GiOverrides::default(), Quality::Accurate)
+            .is_err());
         args.vct.drop_ignored_by(true, false);
-        let gi = cone_tracing(args.render_settings(&GiOverrides::default()).unwrap());
+        let gi = cone_tracing(
+            args.render_settings(&GiOverrides::default(), Quality::Accurate)
+                .unwrap(),
+        );
         assert_eq!(gi.cones.diffuse_cones, 9);
         assert!(gi.cones.snapped_cones);
+    }
+
+    /// `render` takes the accurate defaults (the lattice, the voxels by memory), `view`
+    /// and `bench` the fast ones (the ring); `--quality` and the scene file's `quality`
+    /// choose, and the ring's options keep the ring.
+    #[test]
+    fn one_image_is_accurate_frames_are_fast() {
+        let settings = |args: &[&str], scene: &GiOverrides| {
+            let cli = Cli::try_parse_from(args).unwrap();
+            let gi = match cli.command {
+                Some(Command::Render(r)) => r.common.render_settings(scene, Quality::Accurate),
+                Some(Command::View(v)) => v.common.render_settings(scene, Quality::Fast),
+                Some(Command::Bench(b)) => b.common.render_settings(scene, Quality::Fast),
+                _ => unreachable!(),
+            };
+            let gi = cone_tracing(gi.unwrap());
+            let Resolution::Auto { quality, .. } = gi.voxels else {
+                panic!("a given resolution");
+            };
+            (gi.cones.lattice_cones, quality)
+        };
+        let none = GiOverrides::default();
+        let accurate = (LATTICE_CONES, Quality::Accurate);
+        assert_eq!(settings(&["voxcone", "render"], &none), accurate);
+        assert_eq!(settings(&["voxcone", "view"], &none), (0, Quality::Fast));
+        assert_eq!(settings(&["voxcone", "bench"], &none), (0, Quality::Fast));
+        let fast = ["voxcone", "render", "--quality", "fast"];
+        assert_eq!(settings(&fast, &none), (0, Quality::Fast));
+        let scene = GiOverrides {
+            quality: Some(Quality::Accurate),
+            ..Default::default()
+        };
+        assert_eq!(settings(&["voxcone", "view"], &scene), accurate);
+        assert_eq!(
+            settings(&["voxcone", "view", "--quality", "fast"], &scene),
+            (0, Quality::Fast)
+        );
+        for ring in [
+            &["--diffuse-cones", "9"][..],
+            &["--cosine-cones"],
+            &["--snapped-cones"],
+            &["--step-factor", "0.3"],
+        ] {
+            let args = [&["voxcone", "render"][..], ring].concat();
+            assert_eq!(settings(&args, &none), (0, Quality::Accurate), "{ring:?}");
+        }
+        let cone = ["voxcone", "render", "--cone", "1"];
+        assert_eq!(settings(&cone, &none), (0, Quality::Accurate));
+        let octree = ["voxcone", "render", "--gi", "octree"];
+        assert_eq!(settings(&octree, &none), accurate);
+        let error = Cli::try_parse_from(["voxcone", "render", "--gi", "off", "--quality", "fast"])
+            .map(|cli| match cli.command {
+                Some(Command::Render(r)) => r.common.render_settings(&none, Quality::Accurate),
+                _ => unreachable!(),
+            })
+            .unwrap()
+            .unwrap_err();
+        assert!(
+            error.to_string().contains("--quality works on the voxels"),
+            "{error}"
+        );
     }
 
     #[test]
     fn rows_filter_the_dense_grid_only() {
         let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-            Some(Command::Render(r)) => r.common.render_settings(&GiOverrides::default()),
+            Some(Command::Render(r)) => r
+                .common
+                .render_settings(&GiOverrides::default(), Quality::Accurate),
             _ => unreachable!(),
         };
         let gi =
@@ -842,7 +934,7 @@ mod tests {
             ..Default::default()
         };
         let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-            Some(Command::Render(r)) => r.common.render_settings(&scene),
+            Some(Command::Render(r)) => r.common.render_settings(&scene, Quality::Accurate),
             _ => unreachable!(),
         };
         let gi =

@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use super::{check_validation, create_context, load_scene, Offscreen};
 use crate::cli::BenchArgs;
+use crate::gi::vct::Quality;
 use crate::renderer::{OutputTarget, Renderer};
 use crate::vk::ImageUse;
 
@@ -84,7 +85,7 @@ pub fn run(args: &BenchArgs) -> Result<BenchReport> {
     let (width, height) = crate::cli::image_size(args.size, &scene);
     let extent = vk::Extent2D { width, height };
     let offscreen = Offscreen::new(&ctx, extent)?;
-    let mut settings = args.common.render_settings(&scene.gi)?;
+    let mut settings = args.common.render_settings(&scene.gi, Quality::Fast)?;
     // Every pass runs every frame, so that the table shows what each one costs.
     settings.cache_shadows = false;
     let mut renderer = Renderer::new(&ctx, scene, settings, extent, super::LDR_FORMAT)?;

@@ -8,6 +8,7 @@ use ash::vk;
 
 use super::{check_validation, create_context, load_scene, Offscreen};
 use crate::cli::{RenderArgs, MAX_IMAGE_SIDE};
+use crate::gi::vct::Quality;
 use crate::imageio::{box_downsample, box_downsample_srgb8};
 use crate::renderer::{OutputTarget, Renderer};
 use crate::vk::{copy_image_to_buffer, Buffer, ImageUse};
@@ -38,7 +39,7 @@ fn output_format(path: &Path) -> Result<Format> {
 pub fn run(args: &RenderArgs) -> Result<PathBuf> {
     let format = output_format(&args.output)?;
     let scene = load_scene(&args.common)?;
-    let settings = args.common.render_settings(&scene.gi)?;
+    let settings = args.common.render_settings(&scene.gi, Quality::Accurate)?;
     let samples = if settings.gi.filters_pixels() {
         if args.supersample != 1 {
             log::info!("the technique filters each pixel itself: one sample per pixel to render");

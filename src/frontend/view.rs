@@ -28,6 +28,7 @@ use winit::window::{Window, WindowId};
 use super::ui::{Panel, PanelView, Request};
 use super::{check_validation, create_context, load_scene};
 use crate::cli::{CommonArgs, ViewArgs};
+use crate::gi::vct::Quality;
 use crate::renderer::{OutputTarget, Renderer};
 use crate::vk::{copy_image_to_buffer, Acquired, Buffer, Context, ImageUse, Swapchain};
 
@@ -141,7 +142,7 @@ impl Viewer {
         };
         let swapchain = Swapchain::new(&ctx, surface, extent)?;
         let scene = load_scene(&args.common)?;
-        let settings = args.common.render_settings(&scene.gi)?;
+        let settings = args.common.render_settings(&scene.gi, Quality::Fast)?;
         let bounds = scene.bounds(0.0);
         let diagonal = (bounds.max - bounds.min).length();
         // Camera speed follows the scene's units; a scene of one point moves by units.
@@ -178,7 +179,10 @@ impl Viewer {
     /// the view). A setting
     /// the command line would refuse is reported in the panel and changes nothing.
     fn rebuild(&mut self) -> Result<()> {
-        let settings = match self.args.render_settings(&self.renderer.scene.gi) {
+        let settings = match self
+            .args
+            .render_settings(&self.renderer.scene.gi, Quality::Fast)
+        {
             Ok(settings) => settings,
             Err(e) => {
                 self.panel.message = Some(format!("{e:#}"));

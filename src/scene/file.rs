@@ -47,6 +47,7 @@
 //! radiance = [0.3, 0.35, 0.45]   # constant environment radiance, default zero
 //!
 //! [gi]                           # optional; each key as its command-line option, which wins
+//! quality = "accurate"           # --quality: "fast" or "accurate" (default: by the command)
 //! voxels = 64                    # --voxels (default: by the device, see voxel_size)
 //! voxel_size = 0.05              # --voxel-size: instead of voxels, the largest voxel
 //! diffuse_cones = 6              # --diffuse-cones
@@ -57,7 +58,8 @@
 //! wide_steps_by_level = false    # --wide-steps-by-level
 //! cosine_cones = false           # --cosine-cones
 //! snapped_cones = false          # --snapped-cones
-//! lattice_cones = 72             # --lattice-cones (default: off, the ring of diffuse_cones)
+//! lattice_cones = 72             # --lattice-cones (default: 72 where quality is accurate, else
+//!                                #   0, the ring of diffuse_cones)
 //! bounces = 8                    # --bounces
 //! indirect_scale = 2             # --indirect-scale (default: by image height)
 //! shadow_cones = false           # --shadow-cones

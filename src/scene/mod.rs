@@ -197,6 +197,8 @@ impl LoadOptions {
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GiOverrides {
+    /// The cone tracer's defaults (`--quality`).
+    pub quality: Option<crate::gi::vct::Quality>,
     pub voxels: Option<u32>,
     /// The largest voxel wanted, in scene units (`--voxel-size`).
     pub voxel_size: Option<f32>,

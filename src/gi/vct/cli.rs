@@ -6,13 +6,21 @@ use clap::Args;
 use super::octree::check_depth;
 use super::voxelize::Voxelizer;
 use super::{
-    check_voxel_size, check_voxels, ConeSettings, DirectionalFilter, Resolution, Store,
-    VctSettings, DEFAULT_SAMPLED_EMITTERS,
+    check_voxel_size, check_voxels, ConeSettings, DirectionalFilter, Quality, Resolution, Store,
+    VctSettings, DEFAULT_SAMPLED_EMITTERS, LATTICE_CONES,
 };
 use crate::scene::GiOverrides;
 
 #[derive(Args, Debug, Clone, Default)]
 pub struct VctArgs {
+    /// The defaults of the settings not given: fast, for frames in real time (the ring of
+    /// --diffuse-cones; 64 voxels per axis on a CPU driver), or accurate, for one image
+    /// (the lattice of 72 cones, whose error falls as the voxels get finer, at the most
+    /// voxels the device's memory holds, up to 256 per axis; the ring where an option of
+    /// the ring is given: --diffuse-cones, --cosine-cones, --snapped-cones, the steps'
+    /// factors, --cone) [default: accurate for render, fast for view and bench].
+    #[arg(long, value_enum)]
+    pub quality: Option<Quality>,
     /// Voxels per axis of the dense grid, a power of two from 4 to 1024 [default: the scene
     /// file's [gi] voxels, else by the device: 64 on a CPU driver, 256 on a GPU (fewer
     /// where its memory is short, or where --voxel-size asks for larger voxels)].
@@ -124,6 +132,7 @@ impl VctArgs {
     /// The options given that only the cone tracer reads, as their flags.
     pub fn given(&self) -> Vec<&'static str> {
         [
+            (self.quality.is_some(), "--quality"),
             (self.shadow_cones, "--shadow-cones"),
             (self.full_update, "--full-update"),
             (self.voxels.is_some(), "--voxels"),
@@ -172,12 +181,38 @@ impl VctArgs {
         }
     }
 
-    pub fn settings(&self, octree: bool, scene: &GiOverrides) -> Result<VctSettings> {
+    /// `quality` gives the defaults; `ring` says an option outside these (`--cone`) picks
+    /// a cone of the ring.
+    pub fn settings(
+        &self,
+        octree: bool,
+        scene: &GiOverrides,
+        quality: Quality,
+        ring: bool,
+    ) -> Result<VctSettings> {
         let d = ConeSettings::default();
+        // The ring's own options keep the ring where the quality's default is the lattice:
+        // they say which ring is wanted.
+        let ring = ring
+            || self.diffuse_cones.or(scene.diffuse_cones).is_some()
+            || self.cosine_cones
+            || scene.cosine_cones == Some(true)
+            || self.snapped_cones
+            || scene.snapped_cones == Some(true)
+            || self.step_factor.or(scene.step_factor).is_some()
+            || self
+                .bounce_step_factor
+                .or(scene.bounce_step_factor)
+                .is_some()
+            || self.wide_steps_by_level
+            || scene.wide_steps_by_level == Some(true);
         let lattice_cones = self
             .lattice_cones
             .or(scene.lattice_cones)
-            .unwrap_or(d.lattice_cones);
+            .unwrap_or(match quality {
+                Quality::Accurate if !ring => LATTICE_CONES,
+                _ => d.lattice_cones,
+            });
         // The lattice replaces the ring: its layout's options would be ignored.
         let ring = [
             (
@@ -265,15 +300,22 @@ impl VctArgs {
         // The command line over the scene file, a count or a size alike.
         let voxels = match (self.voxels, self.voxel_size) {
             (Some(count), _) => Resolution::Count(count),
-            (None, Some(size)) => Resolution::Auto { size: Some(size) },
+            (None, Some(size)) => Resolution::Auto {
+                size: Some(size),
+                quality,
+            },
             (None, None) => match scene.voxels {
                 Some(count) => Resolution::Count(count),
                 None => Resolution::Auto {
                     size: scene.voxel_size,
+                    quality,
                 },
             },
         };
-        if let Resolution::Auto { size: Some(size) } = voxels {
+        if let Resolution::Auto {
+            size: Some(size), ..
+        } = voxels
+        {
             check_voxel_size(size)?;
         }
         let filter = self.directional_filter;

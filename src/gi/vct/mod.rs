@@ -31,8 +31,8 @@ pub use self::grid::Grid;
 pub use self::octree::Octree;
 pub use self::settings::{
     auto_indirect_scale, auto_voxels, check_voxel_size, check_voxels, ConeSettings,
-    DirectionalFilter, Resolution, Store, VctSettings, CPU_VOXELS, DEFAULT_SAMPLED_EMITTERS,
-    GPU_VOXELS, LATTICE_CONES,
+    DirectionalFilter, Quality, Resolution, Store, VctSettings, CPU_VOXELS,
+    DEFAULT_SAMPLED_EMITTERS, LATTICE_CONES, MOST_VOXELS,
 };
 use super::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,

@@ -37,14 +37,30 @@ pub enum DirectionalFilter {
     Rows,
 }
 
+/// Which defaults the cone tracer takes where neither the command line nor the scene file
+/// gives a setting (`--quality`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Quality {
+    /// For frames in real time (`view` and `bench`): the ring of `--diffuse-cones`,
+    /// [`CPU_VOXELS`] per axis on a CPU driver
+    Fast,
+    /// For one image (`render`): the lattice of [`LATTICE_CONES`] cones, whose error falls
+    /// as the voxels get finer, at the most voxels the device's memory holds (up to
+    /// [`MOST_VOXELS`]), on a CPU driver too. The ring's options (`--diffuse-cones`,
+    /// `--cosine-cones`, `--snapped-cones`, the steps' factors, `--cone`) keep the ring
+    Accurate,
+}
+
 /// Voxels per axis (a power of two): of the dense grid, or effective of the octree.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Resolution {
     /// As given: `--voxels`, `--octree-depth` or the scene file's `voxels`.
     Count(u32),
-    /// From the device and the scene ([`auto_voxels`]); `size` is `--voxel-size` or the
-    /// scene file's `voxel_size`, the largest voxel wanted, in scene units.
-    Auto { size: Option<f32> },
+    /// From the device, the scene and the quality ([`auto_voxels`]); `size` is
+    /// `--voxel-size` or the scene file's `voxel_size`, the largest voxel wanted, in scene
+    /// units.
+    Auto { size: Option<f32>, quality: Quality },
 }
 
 impl Resolution {
@@ -53,20 +69,22 @@ impl Resolution {
     pub fn on(self, ctx: &Context, scene: &Scene, cones: &ConeSettings) -> u32 {
         match self {
             Self::Count(count) => count,
-            Self::Auto { size } => {
-                let gpu = (!ctx.is_cpu()).then(|| ctx.device_local_bytes());
+            Self::Auto { size, quality } => {
+                // The frame rate bounds the voxels on a CPU driver in real time only.
+                let memory = (!ctx.is_cpu() || quality == Quality::Accurate)
+                    .then(|| ctx.device_local_bytes());
                 let extent = Grid::extent_around(scene);
-                let count = auto_voxels(gpu, extent, size, cones.snapped_cones);
-                let device = if gpu.is_some() {
-                    "a GPU"
-                } else {
-                    "a CPU driver"
+                let count = auto_voxels(memory, extent, size, cones.snapped_cones);
+                let device = match (ctx.is_cpu(), quality) {
+                    (false, _) => "a GPU",
+                    (true, Quality::Fast) => "a CPU driver in real time",
+                    (true, Quality::Accurate) => "a CPU driver, for one image",
                 };
                 let voxel = extent / count as f32;
                 let why = match size {
                     Some(size) => format!("voxels of at most {size} wanted, on {device}"),
                     None if cones.snapped_cones => format!("the most on {device}"),
-                    None => "the default cones' resolution".to_owned(),
+                    None => "the ring of cones' resolution".to_owned(),
                 };
                 log::info!("voxels: {count}³ of {voxel} scene units ({why})");
                 if let Some(size) = size.filter(|&size| voxel > size) {
@@ -99,28 +117,30 @@ pub const CPU_VOXELS: u32 = 64;
 /// that keep a closed room closed (48 cones, 21 degrees, let a tenth of its light out;
 /// BENCHMARKS.md, session 34).
 pub const LATTICE_CONES: u32 = 72;
-/// The rule's resolution on a GPU: 256³ keeps the dense grid's whole update, every frame,
-/// within 3 ms on an H100 (Sponza, 1.72 ms); 512³ has eight times the voxels.
-pub const GPU_VOXELS: u32 = 256;
+/// The rule's most where the frame rate does not bound it (a GPU, or one image): 256³ keeps
+/// the dense grid's whole update, every frame, within 3 ms on an H100 (Sponza, 1.72 ms),
+/// and renders a reference scene in 27 to 86 s on lavapipe with the lattice; 512³ has
+/// eight times the voxels and 16 GiB of grid.
+pub const MOST_VOXELS: u32 = 256;
 /// The dense grid's bytes per voxel, volumes, their mips and the fragment sums (`bench`'s
 /// `memory_mib`: 2011 MiB at 256³).
 const BYTES_PER_VOXEL: u64 = 126;
 
 /// Voxels per axis when none are given.
-/// - The device sets the most: [`CPU_VOXELS`] on a CPU driver (`gpu` is `None`); on a GPU
-///   [`GPU_VOXELS`], halved while the grid would take more than a quarter of its
-///   device-local memory (`gpu`, bytes).
+/// - The device sets the most: [`CPU_VOXELS`] on a CPU driver in real time (`memory` is
+///   `None`); on a GPU, or for one image ([`Quality::Accurate`]), [`MOST_VOXELS`], halved
+///   while the grid would take more than a quarter of the device-local `memory` (bytes).
 /// - A wanted voxel `size` (in the units of the scene's `extent`) takes the least power of
 ///   two whose voxels are no larger, from [`CPU_VOXELS`] to that most.
 /// - Without one, the most where finer voxels give a better image (`finer_helps`: the
 ///   snapped cones, whose error falls from 64³ to 256³ on four of the five references),
 ///   else [`CPU_VOXELS`]: the default cones are tuned there, and three of the five
 ///   references get worse at 256³ (BENCHMARKS.md, "The default resolution").
-pub fn auto_voxels(gpu: Option<u64>, extent: f32, size: Option<f32>, finer_helps: bool) -> u32 {
-    let most = match gpu {
+pub fn auto_voxels(memory: Option<u64>, extent: f32, size: Option<f32>, finer_helps: bool) -> u32 {
+    let most = match memory {
         None => CPU_VOXELS,
         Some(bytes) => {
-            let mut most = GPU_VOXELS;
+            let mut most = MOST_VOXELS;
             while most > CPU_VOXELS && u64::from(most).pow(3) * BYTES_PER_VOXEL > bytes / 4 {
                 most /= 2;
             }
@@ -352,11 +372,12 @@ mod tests {
     /// never under the CPU's; 64³ for the default cones unless a size is wanted.
     #[test]
     fn default_resolution_follows_the_device_and_the_scene() {
-        // A CPU driver: 64³ whatever its memory or the wanted size.
+        // A CPU driver in real time: 64³ whatever the wanted size.
         assert_eq!(auto_voxels(None, 10.0, None, true), CPU_VOXELS);
         assert_eq!(auto_voxels(None, 10.0, Some(0.001), true), CPU_VOXELS);
-        // A GPU with 80 GiB: 256³ (2 GiB of grid); with 4 GiB, a quarter is 1 GiB: 128³.
-        assert_eq!(auto_voxels(Some(80 * GIB), 10.0, None, true), GPU_VOXELS);
+        // A GPU, or one image, with 80 GiB: 256³ (2 GiB of grid); with 4 GiB, a quarter is
+        // 1 GiB: 128³.
+        assert_eq!(auto_voxels(Some(80 * GIB), 10.0, None, true), MOST_VOXELS);
         assert_eq!(auto_voxels(Some(4 * GIB), 10.0, None, true), 128);
         assert_eq!(auto_voxels(Some(GIB / 4), 10.0, None, true), CPU_VOXELS);
         // Without a wanted size the default cones keep 64³ on every device.
@@ -371,7 +392,7 @@ mod tests {
         );
         assert_eq!(
             auto_voxels(Some(80 * GIB), 1e30, Some(1e-30), false),
-            GPU_VOXELS
+            MOST_VOXELS
         );
     }
 }

@@ -5,7 +5,9 @@ use std::sync::Arc;
 
 use super::super::reference;
 use super::super::voxelize::Voxelizer;
-use super::super::{DirectionalFilter, Grid, Resolution, Store, CPU_VOXELS};
+use super::super::{
+    auto_voxels, DirectionalFilter, Grid, Quality, Resolution, Store, CPU_VOXELS, LATTICE_CONES,
+};
 use super::Volume;
 use crate::gi::GiSettings;
 use crate::renderer::Renderer;
@@ -364,23 +366,38 @@ fn voxel_list_holds_exactly_the_occupied_voxels() {
 
 /// Without a given resolution the renderer applies the rule for its device, keeps the
 /// count in its settings (the viewer's panel shows it) and builds the grid at it: on a
-/// CPU driver 64³, with or without a wanted voxel size, snapped cones or not.
+/// CPU driver in real time 64³, with or without a wanted voxel size, snapped cones or not;
+/// for one image with the lattice, the most its memory holds.
 #[test]
 fn the_default_resolution_reaches_the_grid() {
     let scene = Scene::load(&crate::cli::default_scene(), &LoadOptions::default()).unwrap();
     let extent = Grid::extent_around(&scene);
-    for (size, snapped) in [(None, false), (None, true), (Some(extent / 512.0), false)] {
+    let cases = [
+        (None, false, Quality::Fast),
+        (None, true, Quality::Fast),
+        (Some(extent / 512.0), false, Quality::Fast),
+        (None, true, Quality::Accurate),
+    ];
+    for (size, lattice, quality) in cases {
         let mut settings = gi_settings(0, DENSE, false);
         let vct = cone_settings(&mut settings);
-        vct.voxels = Resolution::Auto { size };
-        vct.cones.snapped_cones = snapped;
+        vct.voxels = Resolution::Auto { size, quality };
+        if lattice {
+            vct.cones.lattice_cones = LATTICE_CONES;
+            vct.cones.snapped_cones = true;
+        }
+        vct.cones.bounces = 1;
         let (ctx, renderer) = render_frames(scene.clone(), settings, &[0.0]);
         assert_eq!(ctx.validation_messages(), 0);
         assert!(ctx.is_cpu(), "the rule's GPU branch is tested on its own");
+        let want = match quality {
+            Quality::Fast => CPU_VOXELS,
+            Quality::Accurate => auto_voxels(Some(ctx.device_local_bytes()), extent, size, true),
+        };
         let GiSettings::ConeTracing(kept) = &renderer.settings.gi else {
             panic!("no cone tracing");
         };
-        assert_eq!(kept.voxels, Resolution::Count(CPU_VOXELS), "{size:?}");
-        assert_eq!(dense(&renderer).grid().resolution, CPU_VOXELS);
+        assert_eq!(kept.voxels, Resolution::Count(want), "{size:?} {quality:?}");
+        assert_eq!(dense(&renderer).grid().resolution, want);
     }
 }
