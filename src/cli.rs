@@ -470,6 +470,7 @@ impl CommonArgs {
                 budget_mib: self.shadow_budget,
             },
             cache_shadows: true,
+            opaque_shadow_cut_outs: self.is_reference(),
             terms: Terms {
                 direct: !self.no_direct,
                 emission: !self.no_emission,

@@ -210,6 +210,8 @@ gpu_layout! {
         SPEC_SNAPPED_CONES = 1;
         /// Specialization constant id, given to every pipeline of voxel cone tracing: the cones of the screen's diffuse gather's lattice (`--lattice-cones`), spread evenly over the cosine-weighted hemisphere; 0 for the ring of `diffuse_cones`. A constant for the reason `SPEC_SNAPPED_CONES` is one; the ring's gather also ran 0.5 % slower on lavapipe with the lattice's branch on a uniform.
         SPEC_LATTICE_CONES = 2;
+        /// Specialization constant id of the shadow pass: 1 where cut-outs cast whole shadows whatever their coverage (`RenderSettings::opaque_shadow_cut_outs`, the references' convention), 0 where they cast none where cut.
+        SPEC_SHADOW_OPAQUE_CUT_OUTS = 0;
         /// Workgroup size of the passes over fragments and over a level's nodes.
         OCTREE_GROUP_SIZE = 64;
         /// Workgroups along y of a dispatch over an update list: the border transfer, filter and spread passes share each node's work (texels, children, neighbours) among them, so that a short list still fills the GPU (1 on a CPU driver, where a workgroup costs more than the work it shares).

@@ -96,7 +96,13 @@ impl Renderer {
             FRAMES_IN_FLIGHT as u32,
         )?;
         let set_layouts = [frame_sets.layout, gpu.sets.layout];
-        let shadow = ShadowPass::new(ctx, &scene, settings.shadow_resolution, &set_layouts)?;
+        let shadow = ShadowPass::new(
+            ctx,
+            &scene,
+            settings.shadow_resolution,
+            settings.opaque_shadow_cut_outs,
+            &set_layouts,
+        )?;
         let gbuffer_pass = GBufferPass::new(ctx, &set_layouts)?;
         let lighting = LightingPass::new(ctx, set_layouts)?;
         let composite = CompositePass::new(ctx, set_layouts, output_format)?;

@@ -56,6 +56,11 @@ pub struct RenderSettings {
     pub shadow_resolution: ShadowResolution,
     /// Keep the shadow maps while no light and no mesh moves.
     pub cache_shadows: bool,
+    /// Cut-outs (map_d) cast whole shadows from the lights, whatever their coverage: the
+    /// references' convention (their Mitsuba integrator ignores its masks on the rays of
+    /// next-event estimation, as the path tracer does under the same switch), implied by a
+    /// reference `*.scene.json`. Off: they cast none where cut.
+    pub opaque_shadow_cut_outs: bool,
     /// The global-illumination technique and its settings.
     pub gi: GiSettings,
     pub terms: Terms,
@@ -74,6 +79,7 @@ impl Default for RenderSettings {
             tonemap: Tonemap::Clamp,
             shadow_resolution: ShadowResolution::default(),
             cache_shadows: true,
+            opaque_shadow_cut_outs: false,
             gi: GiSettings::Off,
             terms: Terms::default(),
             debug_view: DebugView::None,

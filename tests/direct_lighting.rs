@@ -250,3 +250,71 @@ fn a_thousand_point_lights_render_within_the_shadow_budget() {
     let centre = ((16 * 32 + 16) * 3) as usize;
     assert!(image.data[centre] > 0.0, "the quad is unlit");
 }
+
+/// A white floor under a cut-out quad (map_d wholly transparent) lit from straight above:
+/// the camera sees the floor through the quad either way, but the sun's light on it
+/// depends on the scene's conventions. From a scene file the quad casts no shadow where
+/// it is cut (the floor shows 3 x 0.8 / π); under a reference `*.scene.json`'s
+/// conventions cut-outs cast whole shadows, as the references' Mitsuba integrator ignores
+/// its masks on the rays of next-event estimation, and the rasterized direct light
+/// agrees with the path tracer's (`--max-depth 2`, whose shadow rays do the same).
+#[test]
+fn cut_outs_shadow_as_the_scenes_conventions_say() {
+    let dir = temp_dir("cut_out_shadow");
+    let mut mask = image::RgbaImage::new(4, 4);
+    mask.pixels_mut()
+        .for_each(|p| *p = image::Rgba([255, 255, 255, 0]));
+    mask.save(dir.join("mask.png")).unwrap();
+    common::write(
+        &dir,
+        "q.mtl",
+        "newmtl floor\nKd 0.8 0.8 0.8\nnewmtl leaf\nKd 1 1 1\nmap_d mask.png\n",
+    );
+    common::write(
+        &dir,
+        "q.obj",
+        "mtllib q.mtl\n\
+         v -2 0 2\nv 2 0 2\nv 2 0 -2\nv -2 0 -2\n\
+         v -0.5 1 0.5\nv 0.5 1 0.5\nv 0.5 1 -0.5\nv -0.5 1 -0.5\n\
+         vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+         usemtl floor\nf 1 2 3 4\nusemtl leaf\nf 5/1 6/2 7/3 8/4\n",
+    );
+    let toml = common::write(
+        &dir,
+        "q.toml",
+        "[camera]\nposition = [0, 3, 0.01]\ntarget = [0, 0, 0]\nfov_y_deg = 10\n\
+         [[mesh]]\npath = \"q.obj\"\n\
+         [[light]]\nkind = \"directional\"\ndirection = [0, -1, 0]\nirradiance = [3, 3, 3]\n",
+    );
+    let json = common::write(
+        &dir,
+        "q.scene.json",
+        r#"{"scenes_root": ".", "obj": "q.obj", "resolution": [32, 32],
+            "camera": {"pos": [0, 3, 0.01], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 10},
+            "lights": {"point": [], "directional": [{"direction_of_travel": [0, -1, 0],
+            "irradiance_W_m2": [3, 3, 3]}], "env_radiance": [0, 0, 0],
+            "mtl_emission": true, "emission_scale": 1.0}}"#,
+    );
+    let centre = |path: &std::path::Path| {
+        let (image, _) = load_rgb(path).unwrap();
+        let at = (16 * 32 + 16) * 3;
+        image.data[at..at + 3].iter().sum::<f32>() / 3.0
+    };
+    let lit = 3.0 * 0.8 / std::f32::consts::PI;
+    let out = dir.join("toml.exr");
+    common::render(&toml, &["--gi", "off", "--size", "32x32"], &out);
+    let unshadowed = centre(&out);
+    let out = dir.join("json.exr");
+    common::render(&json, &["--gi", "off"], &out);
+    let shadowed = centre(&out);
+    let path = dir.join("path.exr");
+    common::render_path(&json, &["--spp", "16", "--max-depth", "2"], &path);
+    let traced = centre(&path);
+    eprintln!(
+        "floor under the cut-out: scene file {unshadowed:.4} (lit {lit:.4}), reference \
+         conventions {shadowed:.4}, the path tracer {traced:.4}"
+    );
+    assert!((unshadowed / lit - 1.0).abs() <= 0.02, "{unshadowed}");
+    assert!(shadowed <= 0.01 * lit, "{shadowed}");
+    assert!(traced <= 0.01 * lit, "{traced}");
+}

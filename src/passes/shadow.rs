@@ -334,6 +334,7 @@ impl ShadowPass {
         ctx: &Arc<Context>,
         scene: &Scene,
         resolution: ShadowResolution,
+        opaque_cut_outs: bool,
         set_layouts: &[vk::DescriptorSetLayout],
     ) -> Result<Self> {
         let limits = &ctx.properties.limits;
@@ -374,7 +375,7 @@ impl ShadowPass {
                 cull: vk::CullModeFlags::NONE,
                 dynamic_depth_bias: true,
                 depth_clamp: ctx.features.depth_clamp,
-                constants: &[],
+                constants: &[u32::from(opaque_cut_outs)],
             },
         )?;
         Ok(Self {
