@@ -615,6 +615,15 @@ mod tests {
         assert!(text.contains("magic") && text.contains("off"), "{text}");
     }
 
+    /// The settings `render` makes of the command line `args` with the scene file's `[gi]`
+    /// table `scene`.
+    fn render(args: &[&str], scene: &GiOverrides) -> Result<RenderSettings> {
+        match Cli::try_parse_from(args).unwrap().command {
+            Some(Command::Render(r)) => r.common.render_settings(scene, Quality::Accurate),
+            _ => unreachable!(),
+        }
+    }
+
     #[test]
     fn command_line_wins_over_the_scene_file_over_the_defaults() {
         let scene = GiOverrides {
@@ -623,12 +632,7 @@ mod tests {
             shadow_cones: Some(true),
             ..Default::default()
         };
-        let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-            Some(Command::Render(r)) => {
-                r.common.render_settings(&scene, Quality::Accurate).unwrap()
-            }
-            _ => unreachable!(),
-        };
+        let parse = |args: &[&str]| render(args, &scene).unwrap();
         let gi = cone_tracing(parse(&["voxcone", "render"]));
         assert_eq!(
             (gi.voxels, gi.cones.diffuse_cones),
@@ -654,14 +658,7 @@ mod tests {
     /// file; without either the device decides (`Resolution::Auto`).
     #[test]
     fn voxels_come_from_a_count_a_size_or_the_device() {
-        let parse =
-            |scene: GiOverrides, args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-                Some(Command::Render(r)) => r
-                    .common
-                    .render_settings(&scene, Quality::Accurate)
-                    .map(cone_tracing),
-                _ => unreachable!(),
-            };
+        let parse = |scene: GiOverrides, args: &[&str]| render(args, &scene).map(cone_tracing);
         let none = GiOverrides::default();
         let sized = GiOverrides {
             voxel_size: Some(0.5),
@@ -709,12 +706,7 @@ mod tests {
     /// without `--cone` the layout's options are still the voxels' alone.
     #[test]
     fn path_cone_takes_the_gathers_layout() {
-        let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-            Some(Command::Render(r)) => r
-                .common
-                .render_settings(&GiOverrides::default(), Quality::Accurate),
-            _ => unreachable!(),
-        };
+        let parse = |args: &[&str]| render(args, &GiOverrides::default());
         let settings = parse(&[
             "voxcone",
             "render",
@@ -754,12 +746,7 @@ mod tests {
     /// and components it refuses; snapped cones refuse the steps' options.
     #[test]
     fn lattice_replaces_the_ring() {
-        let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-            Some(Command::Render(r)) => r
-                .common
-                .render_settings(&GiOverrides::default(), Quality::Accurate),
-            _ => unreachable!(),
-        };
+        let parse = |args: &[&str]| render(args, &GiOverrides::default());
         let gi = cone_tracing(parse(&["voxcone", "render", "--lattice-cones", "72"]).unwrap());
         assert_eq!(gi.cones.lattice_cones, 72);
         assert!(gi.cones.snapped_cones);
@@ -887,13 +874,11 @@ mod tests {
         assert_eq!(settings(&cone, &none), (0, Quality::Accurate));
         let octree = ["voxcone", "render", "--gi", "octree"];
         assert_eq!(settings(&octree, &none), accurate);
-        let error = Cli::try_parse_from(["voxcone", "render", "--gi", "off", "--quality", "fast"])
-            .map(|cli| match cli.command {
-                Some(Command::Render(r)) => r.common.render_settings(&none, Quality::Accurate),
-                _ => unreachable!(),
-            })
-            .unwrap()
-            .unwrap_err();
+        let error = render(
+            &["voxcone", "render", "--gi", "off", "--quality", "fast"],
+            &none,
+        )
+        .unwrap_err();
         assert!(
             error.to_string().contains("--quality works on the voxels"),
             "{error}"
@@ -902,12 +887,7 @@ mod tests {
 
     #[test]
     fn rows_filter_the_dense_grid_only() {
-        let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-            Some(Command::Render(r)) => r
-                .common
-                .render_settings(&GiOverrides::default(), Quality::Accurate),
-            _ => unreachable!(),
-        };
+        let parse = |args: &[&str]| render(args, &GiOverrides::default());
         let gi =
             cone_tracing(parse(&["voxcone", "render", "--directional-filter", "rows"]).unwrap());
         assert_eq!(
@@ -934,10 +914,7 @@ mod tests {
             bounce_step_factor: Some(0.4),
             ..Default::default()
         };
-        let parse = |args: &[&str]| match Cli::try_parse_from(args).unwrap().command {
-            Some(Command::Render(r)) => r.common.render_settings(&scene, Quality::Accurate),
-            _ => unreachable!(),
-        };
+        let parse = |args: &[&str]| render(args, &scene);
         let gi =
             cone_tracing(parse(&["voxcone", "render", "--shadow-step-factor", "0.3"]).unwrap());
         let d = ConeSettings::default();

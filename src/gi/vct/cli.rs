@@ -191,30 +191,8 @@ impl VctArgs {
         ring: bool,
     ) -> Result<VctSettings> {
         let d = ConeSettings::default();
-        // The ring's own options keep the ring where the quality's default is the lattice:
-        // they say which ring is wanted.
-        let ring = ring
-            || self.diffuse_cones.or(scene.diffuse_cones).is_some()
-            || self.cosine_cones
-            || scene.cosine_cones == Some(true)
-            || self.snapped_cones
-            || scene.snapped_cones == Some(true)
-            || self.step_factor.or(scene.step_factor).is_some()
-            || self
-                .bounce_step_factor
-                .or(scene.bounce_step_factor)
-                .is_some()
-            || self.wide_steps_by_level
-            || scene.wide_steps_by_level == Some(true);
-        let lattice_cones = self
-            .lattice_cones
-            .or(scene.lattice_cones)
-            .unwrap_or(match quality {
-                Quality::Accurate if !ring => LATTICE_CONES,
-                _ => d.lattice_cones,
-            });
-        // The lattice replaces the ring: its layout's options would be ignored.
-        let ring = [
+        // The ring's layout and the trilinear cones' steps, each option given or not.
+        let layout = [
             (
                 self.diffuse_cones.or(scene.diffuse_cones).is_some(),
                 "--diffuse-cones / diffuse_cones",
@@ -224,14 +202,6 @@ impl VctArgs {
                 "--cosine-cones / cosine_cones",
             ),
         ];
-        if let Some((_, option)) = ring.iter().find(|(set, _)| lattice_cones != 0 && *set) {
-            bail!("{option} sets the ring of cones: --lattice-cones / lattice_cones replaces it");
-        }
-        let snapped_cones = self.snapped_cones
-            || scene.snapped_cones.unwrap_or(d.snapped_cones)
-            || lattice_cones > 0;
-        // Snapped cones march from cell to cell (cones.glsl, march_cells): the steps'
-        // options would be ignored.
         let steps = [
             (
                 self.step_factor.or(scene.step_factor).is_some(),
@@ -248,6 +218,26 @@ impl VctArgs {
                 "--wide-steps-by-level / wide_steps_by_level",
             ),
         ];
+        let snapped_given = self.snapped_cones || scene.snapped_cones == Some(true);
+        // The ring's own options keep the ring where the quality's default is the lattice:
+        // they say which ring is wanted.
+        let ring = ring || snapped_given || layout.iter().chain(&steps).any(|(set, _)| *set);
+        let lattice_cones = self
+            .lattice_cones
+            .or(scene.lattice_cones)
+            .unwrap_or(match quality {
+                Quality::Accurate if !ring => LATTICE_CONES,
+                _ => d.lattice_cones,
+            });
+        // The lattice replaces the ring: its layout's options would be ignored.
+        if let Some((_, option)) = layout.iter().find(|(set, _)| lattice_cones != 0 && *set) {
+            bail!("{option} sets the ring of cones: --lattice-cones / lattice_cones replaces it");
+        }
+        let snapped_cones = self.snapped_cones
+            || scene.snapped_cones.unwrap_or(d.snapped_cones)
+            || lattice_cones > 0;
+        // Snapped cones march from cell to cell (cones.glsl, march_cells): the steps'
+        // options would be ignored.
         if let Some((_, option)) = steps.iter().find(|(set, _)| snapped_cones && *set) {
             bail!(
                 "{option} sets the steps of the trilinear cones: snapped cones (--snapped-cones, \
