@@ -93,13 +93,15 @@ pub struct CommonArgs {
     #[arg(long, value_enum, default_value_t = Tonemap::Clamp)]
     pub tonemap: Tonemap,
     /// Shadow map resolution of each view of a point or spot light: a power of two,
-    /// 16 to 8192.
-    #[arg(long, default_value_t = 1024, value_parser = parse_shadow_res)]
-    pub shadow_res: u32,
+    /// 16 to 8192 [default: 1024 for frames (view, bench), 4096 for one image (render,
+    /// unless --quality fast)].
+    #[arg(long, value_parser = parse_shadow_res)]
+    pub shadow_res: Option<u32>,
     /// Shadow map resolution of a directional light, whose one view covers the whole
-    /// scene: a power of two, 16 to 8192.
-    #[arg(long, default_value_t = 4096, value_parser = parse_shadow_res)]
-    pub sun_shadow_res: u32,
+    /// scene: a power of two, 16 to 8192 [default: 4096 for frames (view, bench), 8192
+    /// for one image (render, unless --quality fast)].
+    #[arg(long, value_parser = parse_shadow_res)]
+    pub sun_shadow_res: Option<u32>,
     /// The most memory the shadow maps may take, in MiB; with many lights the views'
     /// resolutions are halved until they fit.
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=65536))]
@@ -374,11 +376,15 @@ impl CommonArgs {
     }
 
     /// The settings of a frame: the command line over the scene file's `[gi]` over the
-    /// defaults, the cone tracer's those of `quality` unless `--quality` or the scene file
-    /// says otherwise (`render` asks for [`Quality::Accurate`], `view` and `bench` for
+    /// defaults, the cone tracer's and the shadow maps' those of `quality` unless
+    /// `--quality` or the scene file says otherwise (`render` asks for [`Quality::Accurate`], `view` and `bench` for
     /// [`Quality::Fast`]).
     pub fn render_settings(&self, scene: &GiOverrides, quality: Quality) -> Result<RenderSettings> {
         let quality = self.vct.quality.or(scene.quality).unwrap_or(quality);
+        let shadows = match quality {
+            Quality::Fast => ShadowResolution::FRAMES,
+            Quality::Accurate => ShadowResolution::ONE_IMAGE,
+        };
         let options = self.load_options();
         if self.vct.octree_depth.is_some() && self.gi != GiMode::Octree {
             bail!("--octree-depth sets the sparse voxel octree: it needs --gi octree");
@@ -465,8 +471,8 @@ impl CommonArgs {
             exposure_ev: self.exposure,
             tonemap: self.tonemap,
             shadow_resolution: ShadowResolution {
-                local: self.shadow_res,
-                directional: self.sun_shadow_res,
+                local: self.shadow_res.unwrap_or(shadows.local),
+                directional: self.sun_shadow_res.unwrap_or(shadows.directional),
                 budget_mib: self.shadow_budget,
             },
             cache_shadows: true,
@@ -883,6 +889,44 @@ mod tests {
             error.to_string().contains("--quality works on the voxels"),
             "{error}"
         );
+    }
+
+    /// `render` draws its shadow maps finer than the frames do, `--quality fast` as the
+    /// frames, and the flags win over both.
+    #[test]
+    fn one_image_takes_finer_shadow_maps() {
+        let shadows = |args: &[&str]| {
+            let cli = Cli::try_parse_from(args).unwrap();
+            let settings = match cli.command {
+                Some(Command::Render(r)) => r
+                    .common
+                    .render_settings(&GiOverrides::default(), Quality::Accurate),
+                Some(Command::View(v)) => v
+                    .common
+                    .render_settings(&GiOverrides::default(), Quality::Fast),
+                _ => unreachable!(),
+            };
+            let r = settings.unwrap().shadow_resolution;
+            (r.local, r.directional)
+        };
+        assert_eq!(shadows(&["voxcone", "render"]), (4096, 8192));
+        assert_eq!(shadows(&["voxcone", "render", "--gi", "off"]), (4096, 8192));
+        assert_eq!(shadows(&["voxcone", "view"]), (1024, 4096));
+        assert_eq!(
+            shadows(&["voxcone", "render", "--quality", "fast"]),
+            (1024, 4096)
+        );
+        let given = [
+            "voxcone",
+            "render",
+            "--shadow-res",
+            "512",
+            "--sun-shadow-res",
+            "2048",
+        ];
+        assert_eq!(shadows(&given), (512, 2048));
+        let given = ["voxcone", "view", "--shadow-res", "2048"];
+        assert_eq!(shadows(&given), (2048, 4096));
     }
 
     #[test]

@@ -42,15 +42,32 @@ pub struct ShadowResolution {
 
 impl Default for ShadowResolution {
     fn default() -> Self {
-        Self {
-            local: 1024,
-            directional: 4096,
-            budget_mib: 512,
-        }
+        Self::FRAMES
     }
 }
 
 impl ShadowResolution {
+    /// For frames in real time (`view`, `bench`): a directional light's one view covers
+    /// the whole scene, so it takes more texels than a point light's faces (on Sponza a
+    /// 1024 map gave 4 cm texels and, with the PCF, 20 cm penumbrae; BENCHMARKS.md,
+    /// session 7).
+    pub const FRAMES: Self = Self {
+        local: 1024,
+        directional: 4096,
+        budget_mib: 512,
+    };
+    /// For one image (`render`): the references' lights are points and a sun without
+    /// extent, whose shadows are hard, where a shadow map's penumbra (its PCF kernel) and
+    /// the normal offset that keeps a surface from shadowing itself both span a few of its
+    /// texels; finer texels bring the direct light towards the path tracer's on every
+    /// reference (BENCHMARKS.md, session 39). A point light's six faces at 4096 and the
+    /// sun's view at 8192 each fit the default budget; more lights are cut to fit it.
+    pub const ONE_IMAGE: Self = Self {
+        local: 4096,
+        directional: 8192,
+        budget_mib: 512,
+    };
+
     /// Of each view of `light`.
     pub fn of(&self, light: &Light) -> u32 {
         match light.kind {

@@ -18,7 +18,8 @@ pub struct VctArgs {
     /// (the lattice of 72 cones, whose error falls as the voxels get finer, at the most
     /// voxels the device's memory holds, up to 256 per axis; the ring where an option of
     /// the ring is given: --diffuse-cones, --cosine-cones, --snapped-cones, the steps'
-    /// factors, --cone) [default: accurate for render, fast for view and bench].
+    /// factors, --cone); also the shadow maps' texels (--shadow-res, --sun-shadow-res)
+    /// [default: accurate for render, fast for view and bench].
     #[arg(long, value_enum)]
     pub quality: Option<Quality>,
     /// Voxels per axis of the dense grid, a power of two from 4 to 1024 [default: the scene
