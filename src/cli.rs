@@ -377,8 +377,8 @@ impl CommonArgs {
 
     /// The settings of a frame: the command line over the scene file's `[gi]` over the
     /// defaults, the cone tracer's and the shadow maps' those of `quality` unless
-    /// `--quality` or the scene file says otherwise (`render` asks for [`Quality::Accurate`], `view` and `bench` for
-    /// [`Quality::Fast`]).
+    /// `--quality` or the scene file says otherwise (`render` asks for
+    /// [`Quality::Accurate`], `view` and `bench` for [`Quality::Fast`]).
     pub fn render_settings(&self, scene: &GiOverrides, quality: Quality) -> Result<RenderSettings> {
         let quality = self.vct.quality.or(scene.quality).unwrap_or(quality);
         let shadows = match quality {
