@@ -28,6 +28,12 @@ static ONE_WINDOW: Mutex<()> = Mutex::new(());
 /// display and write its number only once it accepts connections: `xvfb-run -a` guesses
 /// the number from lock files and waits on a signal, and under load its viewer once found
 /// no server (CI, "Failed to open connection to X server").
+///
+/// `-noreset`: an X server resets when its last client disconnects, and a client that
+/// connects during the reset is refused. The scripts' `xdotool search` polls connect and
+/// disconnect while the viewer starts, so without it the viewer's own connection failed
+/// now and then (the same message); a shell loop of `xdotool` clients beside such polls
+/// had 20 of 300 connections refused without the flag, none with it.
 struct VirtualScreen {
     server: Child,
     display: String,
@@ -45,6 +51,7 @@ impl VirtualScreen {
                 "1024x768x24",
                 "-nolisten",
                 "tcp",
+                "-noreset",
             ])
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
