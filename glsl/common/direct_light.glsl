@@ -30,19 +30,55 @@ float shadow_texel_world(ShadowView view, vec3 p) {
     return ortho ? view.texel_size : view.texel_size * distance(p, view.origin.xyz);
 }
 
+// The normal offset, in shadow texels, of a point on a surface (shadow_visibility).
+const float SURFACE_SHADOW_OFFSET = 0.5;
+
+// Where q lands in shadow view `view`, in normalized device coordinates.
+vec3 shadow_ndc(ShadowView view, vec3 q) {
+    vec4 clip = view.view_proj * vec4(q, 1.0);
+    return clip.xyz / clip.w;
+}
+
 // Fraction of the light reaching p (normal n), PCF over (2 pcf_radius + 1)^2 bilinear
-// depth compares. `extra_offset` moves p further along n (voxel centres lie up to half a
-// voxel inside their surface).
-float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset, int pcf_radius) {
+// depth compares, p moved `offset_texels` shadow texels and `extra_offset` along n.
+//
+// Each tap compares the depth of p's own plane where that tap lies (receiver plane depth
+// bias, Isidoro 2006): the taps reach pcf_radius texels from p, where a plane tilted to
+// the light lies deeper or shallower than p by the plane's slope, which one depth for
+// every tap would take for a shadow (acne) or, offset enough to avoid that, for light.
+// What is left, the bilinear footprint of each tap reaching a texel beyond it, is the
+// rasterizer's slope-scaled bias's (ShadowPass, 1.5 texels' worth of slope), so a point
+// on a surface moves only half a texel along n (SURFACE_SHADOW_OFFSET; a whole texel
+// scored worse against the path tracer's direct light on all four references tried). A
+// constant two texels, without the plane, lit the rim of Sponza's planters through the
+// leaves lying on it (its direct light 3.45 times the path tracer's with the sun's map at
+// 8192; 1.91 with half a texel and the plane; BENCHMARKS.md, session 40).
+float shadow_visibility(GpuLight light, vec3 p, vec3 n, float offset_texels, float extra_offset, int pcf_radius) {
     if (light.shadow_view_count == 0u) {
         return 1.0;
     }
     ShadowView view = shadow_views[shadow_view_for(light, p)];
-    // Normal offset of about two texels at p's distance keeps a surface from shadowing
-    // itself without the light leaking through thin walls.
     float texel_world = shadow_texel_world(view, p);
-    vec4 clip = view.view_proj * vec4(p + n * (2.0 * texel_world + extra_offset), 1.0);
-    vec3 ndc = clip.xyz / clip.w;
+    vec3 q = p + n * (offset_texels * texel_world + extra_offset);
+    vec3 ndc = shadow_ndc(view, q);
+    // The plane's depth per texel across the view, from two steps of a texel along it:
+    // the depth's change over the texels' change (one tap needs none). The changes are
+    // taken in the view's own coordinates, not the atlas layer's, whose larger values
+    // would round them (by up to 5e-4 of a texel in a layer of 4096).
+    vec2 slope = vec2(0.0);
+    if (pcf_radius > 0) {
+        vec3 t1 = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+        vec3 t2 = cross(n, t1);
+        vec3 texels = vec3(vec2(0.5 * float(view.resolution)), 1.0);
+        vec3 d1 = (shadow_ndc(view, q + t1 * texel_world) - ndc) * texels;
+        vec3 d2 = (shadow_ndc(view, q + t2 * texel_world) - ndc) * texels;
+        float det = d1.x * d2.y - d2.x * d1.y;
+        // Seen edge-on (the plane's texels collapse to a line) the light arrives at a
+        // grazing angle, where the slope is unbounded: the taps keep p's depth.
+        if (abs(det) > 1e-3) {
+            slope = vec2(d1.z * d2.y - d2.z * d1.y, d2.z * d1.x - d1.z * d2.x) / det;
+        }
+    }
     // The view is a tile of its layer (ShadowAtlas); its neighbours are other views, so
     // every tap's bilinear footprint is clamped half a texel inside the tile.
     vec2 layer_texels = vec2(textureSize(shadow_map, 0).xy);
@@ -53,8 +89,10 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n, float extra_offset, int 
     float sum = 0.0;
     for (int y = -pcf_radius; y <= pcf_radius; y++) {
         for (int x = -pcf_radius; x <= pcf_radius; x++) {
-            vec2 uv = clamp(at + vec2(x, y), lo, hi) / layer_texels;
-            sum += texture(shadow_map, vec4(uv, float(view.layer), ndc.z));
+            vec2 offset = vec2(x, y);
+            vec2 tap = clamp(at + offset, lo, hi);
+            float depth = ndc.z + dot(slope, offset);
+            sum += texture(shadow_map, vec4(tap / layer_texels, float(view.layer), depth));
         }
     }
     float taps = float(2 * pcf_radius + 1);
@@ -98,7 +136,7 @@ vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, out vec3 to_light) {
     if (all(equal(e, vec3(0.0)))) {
         return e;
     }
-    return e * shadow_visibility(light, p, n, 0.0, 2);
+    return e * shadow_visibility(light, p, n, SURFACE_SHADOW_OFFSET, 0.0, 2);
 }
 
 // The BRDF for light arriving from l, seen from v: Lambertian albedo / pi plus, where
