@@ -256,6 +256,32 @@ fn a_thousand_point_lights_render_within_the_shadow_budget() {
     assert!(image.data[centre] > 0.0, "the quad is unlit");
 }
 
+/// A white floor (Kd 0.8) 4 x 4 at y = 0 under a 1 x 1 quad `height` above it whose
+/// texture's alpha is 0 everywhere (`map_d`, a cut-out), as `q.obj` in `dir`.
+fn cut_out_quad_over_a_floor(dir: &std::path::Path, height: f32) {
+    let mut mask = image::RgbaImage::new(4, 4);
+    mask.pixels_mut()
+        .for_each(|p| *p = image::Rgba([255, 255, 255, 0]));
+    mask.save(dir.join("mask.png")).unwrap();
+    common::write(
+        dir,
+        "q.mtl",
+        "newmtl floor\nKd 0.8 0.8 0.8\nnewmtl leaf\nKd 1 1 1\nmap_d mask.png\n",
+    );
+    let h = height;
+    common::write(
+        dir,
+        "q.obj",
+        &format!(
+            "mtllib q.mtl\n\
+             v -2 0 2\nv 2 0 2\nv 2 0 -2\nv -2 0 -2\n\
+             v -0.5 {h} 0.5\nv 0.5 {h} 0.5\nv 0.5 {h} -0.5\nv -0.5 {h} -0.5\n\
+             vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+             usemtl floor\nf 1 2 3 4\nusemtl leaf\nf 5/1 6/2 7/3 8/4\n"
+        ),
+    );
+}
+
 /// A white floor under a cut-out quad (map_d wholly transparent) lit from straight above:
 /// the camera sees the floor through the quad either way, but the sun's light on it
 /// depends on the scene's conventions. From a scene file the quad casts no shadow where
@@ -266,24 +292,7 @@ fn a_thousand_point_lights_render_within_the_shadow_budget() {
 #[test]
 fn cut_outs_shadow_as_the_scenes_conventions_say() {
     let dir = temp_dir("cut_out_shadow");
-    let mut mask = image::RgbaImage::new(4, 4);
-    mask.pixels_mut()
-        .for_each(|p| *p = image::Rgba([255, 255, 255, 0]));
-    mask.save(dir.join("mask.png")).unwrap();
-    common::write(
-        &dir,
-        "q.mtl",
-        "newmtl floor\nKd 0.8 0.8 0.8\nnewmtl leaf\nKd 1 1 1\nmap_d mask.png\n",
-    );
-    common::write(
-        &dir,
-        "q.obj",
-        "mtllib q.mtl\n\
-         v -2 0 2\nv 2 0 2\nv 2 0 -2\nv -2 0 -2\n\
-         v -0.5 1 0.5\nv 0.5 1 0.5\nv 0.5 1 -0.5\nv -0.5 1 -0.5\n\
-         vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
-         usemtl floor\nf 1 2 3 4\nusemtl leaf\nf 5/1 6/2 7/3 8/4\n",
-    );
+    cut_out_quad_over_a_floor(&dir, 1.0);
     let toml = common::write(
         &dir,
         "q.toml",
@@ -336,25 +345,8 @@ fn cut_outs_shadow_as_the_scenes_conventions_say() {
 #[test]
 fn shadows_reach_contacts_and_spare_tilted_planes() {
     let dir = temp_dir("contact_shadow");
-    let mut mask = image::RgbaImage::new(4, 4);
-    mask.pixels_mut()
-        .for_each(|p| *p = image::Rgba([255, 255, 255, 0]));
-    mask.save(dir.join("mask.png")).unwrap();
-    common::write(
-        &dir,
-        "q.mtl",
-        "newmtl floor\nKd 0.8 0.8 0.8\nnewmtl leaf\nKd 1 1 1\nmap_d mask.png\n",
-    );
     // The sun's view spans the bounds' diagonal: 2 x 2.8284 / 1024 = 5.52 mm a texel.
-    common::write(
-        &dir,
-        "q.obj",
-        "mtllib q.mtl\n\
-         v -2 0 2\nv 2 0 2\nv 2 0 -2\nv -2 0 -2\n\
-         v -0.5 0.0055 0.5\nv 0.5 0.0055 0.5\nv 0.5 0.0055 -0.5\nv -0.5 0.0055 -0.5\n\
-         vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
-         usemtl floor\nf 1 2 3 4\nusemtl leaf\nf 5/1 6/2 7/3 8/4\n",
-    );
+    cut_out_quad_over_a_floor(&dir, 0.0055);
     let scene = |name: &str, travel: [f32; 3]| {
         common::write(
             &dir,
