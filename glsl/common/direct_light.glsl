@@ -39,13 +39,23 @@ vec3 shadow_ndc(ShadowView view, vec3 q) {
     return clip.xyz / clip.w;
 }
 
+// Two directions along the plane with normal n (shadow_visibility's t1 and t2).
+void plane_directions(vec3 n, out vec3 t1, out vec3 t2) {
+    t1 = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+    t2 = cross(n, t1);
+}
+
 // Fraction of the light reaching p (normal n), PCF over (2 pcf_radius + 1)^2 bilinear
 // depth compares, p moved `offset_texels` shadow texels and `extra_offset` along n.
 //
-// Each tap compares the depth of p's own plane where that tap lies (receiver plane depth
-// bias, Isidoro 2006): the taps reach pcf_radius texels from p, where a plane tilted to
-// the light lies deeper or shallower than p by the plane's slope, which one depth for
-// every tap would take for a shadow (acne) or, offset enough to avoid that, for light.
+// Each tap compares the depth of p's own plane, along the directions t1 and t2 (not
+// parallel; their lengths do not matter), where that tap lies (receiver plane depth bias,
+// Isidoro 2006): the taps reach pcf_radius texels from p, where a plane tilted to the
+// light lies deeper or shallower than p by the plane's slope, which one depth for every
+// tap would take for a shadow (acne) or, offset enough to avoid that, for light. The
+// plane is the surface the shadow map rasterized, not the shading normal's: a normal map
+// tilts that far off it (the direct light of a normal-mapped floor 17 % off the path
+// tracer's, `normal_maps_and_lobe_match_the_rasterized_direct_light`).
 // What is left, the bilinear footprint of each tap reaching a texel beyond it, is the
 // rasterizer's slope-scaled bias's (ShadowPass, 1.5 texels' worth of slope), so a point
 // on a surface moves only half a texel along n (SURFACE_SHADOW_OFFSET; a whole texel
@@ -53,7 +63,8 @@ vec3 shadow_ndc(ShadowView view, vec3 q) {
 // constant two texels, without the plane, lit the rim of Sponza's planters through the
 // leaves lying on it (its direct light 3.45 times the path tracer's with the sun's map at
 // 8192; 1.91 with half a texel and the plane; BENCHMARKS.md, session 40).
-float shadow_visibility(GpuLight light, vec3 p, vec3 n, float offset_texels, float extra_offset, int pcf_radius) {
+float shadow_visibility(GpuLight light, vec3 p, vec3 n, vec3 t1, vec3 t2, float offset_texels, float extra_offset,
+                        int pcf_radius) {
     if (light.shadow_view_count == 0u) {
         return 1.0;
     }
@@ -61,17 +72,15 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n, float offset_texels, flo
     float texel_world = shadow_texel_world(view, p);
     vec3 q = p + n * (offset_texels * texel_world + extra_offset);
     vec3 ndc = shadow_ndc(view, q);
-    // The plane's depth per texel across the view, from two steps of a texel along it:
-    // the depth's change over the texels' change (one tap needs none). The changes are
+    // The plane's depth per texel across the view, from a step of a texel along each
+    // direction: the depth's change over the texels' change (one tap needs none). The changes are
     // taken in the view's own coordinates, not the atlas layer's, whose larger values
     // would round them (by up to 5e-4 of a texel in a layer of 4096).
     vec2 slope = vec2(0.0);
     if (pcf_radius > 0) {
-        vec3 t1 = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
-        vec3 t2 = cross(n, t1);
         vec3 texels = vec3(vec2(0.5 * float(view.resolution)), 1.0);
-        vec3 d1 = (shadow_ndc(view, q + t1 * texel_world) - ndc) * texels;
-        vec3 d2 = (shadow_ndc(view, q + t2 * texel_world) - ndc) * texels;
+        vec3 d1 = (shadow_ndc(view, q + normalize(t1) * texel_world) - ndc) * texels;
+        vec3 d2 = (shadow_ndc(view, q + normalize(t2) * texel_world) - ndc) * texels;
         float det = d1.x * d2.y - d2.x * d1.y;
         // Seen edge-on (the plane's texels collapse to a line) the light arrives at a
         // grazing angle, where the slope is unbounded: the taps keep p's depth.
@@ -128,15 +137,15 @@ vec3 light_incident(GpuLight light, vec3 p, vec3 n, out vec3 to_light, out float
     return light_arriving(light, p, to_light, dist) * max(dot(n, to_light), 0.0);
 }
 
-// Irradiance at a surface point p (normal n) from one light, shadowed (5x5 PCF), and the
-// unit vector towards it.
-vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, out vec3 to_light) {
+// Irradiance at a surface point p (normal n, its plane along t1 and t2: shadow_visibility)
+// from one light, shadowed (5x5 PCF), and the unit vector towards it.
+vec3 light_irradiance(GpuLight light, vec3 p, vec3 n, vec3 t1, vec3 t2, out vec3 to_light) {
     float dist;
     vec3 e = light_incident(light, p, n, to_light, dist);
     if (all(equal(e, vec3(0.0)))) {
         return e;
     }
-    return e * shadow_visibility(light, p, n, SURFACE_SHADOW_OFFSET, 0.0, 2);
+    return e * shadow_visibility(light, p, n, t1, t2, SURFACE_SHADOW_OFFSET, 0.0, 2);
 }
 
 // The BRDF for light arriving from l, seen from v: Lambertian albedo / pi plus, where

@@ -56,7 +56,10 @@ vec3 radiance_along(uint ray) {
         if (any(greaterThan(e, vec3(0.0)))) {
             // 3 × 3 taps: the probes' rays average over many hits, and the frame's
             // lighting pass keeps its 5 × 5 for what the camera sees.
-            irradiance += e * shadow_visibility(light, p, n, SURFACE_SHADOW_OFFSET, 0.0, 1);
+            vec3 t1;
+            vec3 t2;
+            plane_directions(n, t1, t2);
+            irradiance += e * shadow_visibility(light, p, n, t1, t2, SURFACE_SHADOW_OFFSET, 0.0, 1);
         }
     }
     vec3 radiance = albedo / PI * irradiance + vec3(unpackHalf2x16(b.z), unpackHalf2x16(b.w).x);

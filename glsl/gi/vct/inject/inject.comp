@@ -163,7 +163,8 @@ vec3 voxel_irradiance(GpuLight light, vec3 p, vec3 n) {
     // Sibenik's image by 0.2 %; which is right is a measurement of the voxels' light
     // against their surfaces', not made yet. BENCHMARKS.md, session 40.)
     return e * (cones ? voxel_visibility(p, n, l, dist - vct.origin.w)
-                      : shadow_visibility(light, p, n, VOXEL_SHADOW_OFFSET, 0.5 * vct.origin.w, 0));
+                      : shadow_visibility(light, p, n, vec3(0.0), vec3(0.0), VOXEL_SHADOW_OFFSET,
+                                          0.5 * vct.origin.w, 0));
 }
 
 // Irradiance at the voxel p on its side with (averaged) normal n from sampled emitter
