@@ -75,14 +75,37 @@ vec3 slab_axis(ivec3 v) {
     return top.x + top.y + top.z == 1 ? vec3(top) : vec3(0.0);
 }
 
-// Villegas' normal-weighted attenuation (2018, section 2.1): a voxel's averaged normal n
-// may point where none of its surfaces does (a floor meeting a wall averages to 45
-// degrees and would catch the light of both). Each axis face on n's side takes the
-// light at its own cosine, weighted by n's squared component on that axis.
-float voxel_attenuation(vec3 n, vec3 l) {
-    vec3 w = n * n;
-    vec3 d = max(sign(n) * l, vec3(0.0));
-    return dot(w, d);
+// The axis faces' shares of a voxel whose surfaces' mean normal is along the unit n
+// (voxel_attenuation).
+vec3 face_shares(vec3 n) {
+    return abs(n) / (abs(n.x) + abs(n.y) + abs(n.z));
+}
+
+// How much voxel_attenuation takes the axis faces' light rather than the plane's.
+float faces_weight(float coherence) {
+    return clamp((1.0 - coherence) / (1.0 - sqrt(0.5)), 0.0, 1.0);
+}
+
+// How much of a voxel's surfaces face along the unit vector l, from their mean normal:
+// unit n, its length `coherence` (1: one plane; shorter where the surfaces' normals
+// disagree).
+// - One plane takes the light at its cosine, n . l.
+// - A floor meeting a wall averages to 45 degrees (length 0.71), and the cosine would
+//   catch the light of both at that slant; Villegas' normal-weighted attenuation (2018,
+//   section 2.1) lets each axis face on n's side take the light at its own cosine,
+//   exactly right for faces along the axes. The faces' shares are n's components over
+//   their sum (what a mixture of axis faces averages to); Villegas' squared components
+//   are those shares only for two faces of equal area.
+// The two blend by how far the mean falls short of one plane's, wholly the faces' at two
+// perpendicular faces of equal area or shorter. The faces' weighting alone took a plane
+// at 45 degrees to two axes for 0.71 of its light (0.58 at 55 degrees to all three,
+// 0.91 turned 16 degrees as Cornell's short block; lit along its normal); Sibenik's
+// first bounce was 0.905 of the path tracer's (BENCHMARKS.md, session 40).
+float voxel_attenuation(vec3 n, float coherence, vec3 l) {
+    vec3 share = face_shares(n);
+    float faces = dot(share, max(sign(n) * l, vec3(0.0)));
+    float plane = max(dot(n, l), 0.0);
+    return mix(plane, faces, faces_weight(coherence));
 }
 
 #ifdef OCTREE
@@ -102,7 +125,7 @@ bool segment_meets_box(vec3 p, vec3 d, float dist, vec3 lo, vec3 hi) {
 // Whether the direct light of the voxel at p can differ from when it was last shaded
 // (the lights and shadow views are the same): only where the path to a light passes
 // the region where moving meshes were or are. The region grows by what the lookups
-// reach beyond that path: the shadow lookup's normal offset (two texels and half a
+// reach beyond that path: the shadow lookup's normal offset (two texels and up to 0.87 of a
 // voxel) and its bilinear taps (a texel and a half), or the voxel ray-march's start
 // two voxels out and its cells around the ray; at p's distance a shadow texel is at
 // least as wide as where the path meets the region.
@@ -144,50 +167,70 @@ bool light_may_change(vec3 p) {
 }
 #endif
 
+// How far a plane with unit normal n that crosses a voxel can lie from the voxel's
+// centre along n: half the voxel's extent along n, (|n.x| + |n.y| + |n.z|) / 2 voxels
+// (half a voxel for a plane along the axes, 0.71 at 45 degrees to two, 0.87 to all
+// three). The shadow lookup moves the centre that far out, so that it lies in front of
+// its own surface: half a voxel left most centres of a plane at 45 degrees behind it, in
+// its own shadow (`turned_planes_light_their_voxels_as_planes_along_the_axes`: its
+// voxels' light 0.05 of a plane's along the axes at 64³, 0.71 with this, the rest
+// voxel_attenuation's; BENCHMARKS.md, session 40).
+float voxel_depth(vec3 n) {
+    return 0.5 * (abs(n.x) + abs(n.y) + abs(n.z)) * vct.origin.w;
+}
+
 // The normal offset, in shadow texels, of a voxel's centre (voxel_irradiance).
 const float VOXEL_SHADOW_OFFSET = 2.0;
 
-// Irradiance at the voxel p on its side with (averaged) normal n from one light,
-// shadowed.
-vec3 voxel_irradiance(GpuLight light, vec3 p, vec3 n) {
+// Irradiance at the voxel p on its side with (averaged) normal n, of length `coherence`
+// before it was made unit (voxel_attenuation), from one light, shadowed.
+vec3 voxel_irradiance(GpuLight light, vec3 p, vec3 n, float coherence) {
     vec3 l;
     float dist;
-    vec3 e = light_arriving(light, p, l, dist) * voxel_attenuation(n, l);
+    vec3 e = light_arriving(light, p, l, dist) * voxel_attenuation(n, coherence, l);
     if (all(equal(e, vec3(0.0)))) {
         return e;
     }
     bool cones = (frame.flags & FLAG_SHADOW_CONES) != 0u;
-    // A voxel's centre, half a voxel out along its mean normal, lies on no one plane and
-    // takes one tap, so the receiver plane's reason for half a texel (shadow_visibility)
-    // does not hold for it: it keeps the two texels it had. (Half a texel darkens
-    // Sibenik's image by 0.2 %; which is right is a measurement of the voxels' light
-    // against their surfaces', not made yet. BENCHMARKS.md, session 40.)
+    // A voxel's centre, moved out of its surfaces along their mean normal (voxel_depth),
+    // lies on no one plane and takes one tap, so the receiver plane's reason for half a
+    // texel (shadow_visibility) does not hold for it: it keeps the two texels it had.
+    // (Half a texel darkens Sibenik's image by 0.2 %; BENCHMARKS.md, session 40.)
     return e * (cones ? voxel_visibility(p, n, l, dist - vct.origin.w)
                       : shadow_visibility(light, p, n, vec3(0.0), vec3(0.0), VOXEL_SHADOW_OFFSET,
-                                          0.5 * vct.origin.w, 0));
+                                          voxel_depth(n), 0));
 }
 
-// Irradiance at the voxel p on its side with (averaged) normal n from sampled emitter
-// `emitter` (gi/vct/emitters.glsl), weighted per axis face as the lights' (Villegas), and
-// shadowed by a ray through the voxels along its phi that stops 1.5 voxels short of its
-// plane, where the emitter's own voxels begin. None within a voxel of its plane: a
-// voxel's centre lies up to a voxel from its surfaces, and there it stands for the
-// emitter itself or the surface behind it that holds it (a ceiling), which would see
-// the emitter from a hair's breadth and take nearly pi times its radiance.
-vec3 voxel_emitter_irradiance(VctEmitter emitter, vec3 p, vec3 n) {
+// Irradiance at the voxel p on its side with (averaged) normal n, of length `coherence`,
+// from sampled emitter `emitter` (gi/vct/emitters.glsl), taken by the plane and the axis
+// faces as the lights' (voxel_attenuation), and shadowed by a ray through the voxels
+// along its phi that stops 1.5 voxels short of its plane, where the emitter's own voxels
+// begin. None within a voxel of its plane: a voxel's centre lies up to a voxel from its
+// surfaces, and there it stands for the emitter itself or the surface behind it that
+// holds it (a ceiling), which would see the emitter from a hair's breadth and take nearly
+// pi times its radiance.
+vec3 voxel_emitter_irradiance(VctEmitter emitter, vec3 p, vec3 n, float coherence) {
     if (dot(emitter.plane.xyz, p) - emitter.plane.w < vct.origin.w) {
         return vec3(0.0);
     }
-    vec3 w = n * n;
+    float t = faces_weight(coherence);
     vec3 phi = vec3(0.0);
     float cosine = 0.0;
-    for (int a = 0; a < 3; a++) {
-        if (w[a] > 0.0) {
-            vec3 axis = vec3(0.0);
-            axis[a] = sign(n[a]);
-            vec3 f = emitter_phi(emitter, p, axis);
-            cosine += w[a] * dot(axis, f);
-            phi += w[a] * f;
+    if (t < 1.0) {
+        vec3 f = emitter_phi(emitter, p, n);
+        cosine += (1.0 - t) * max(dot(n, f), 0.0);
+        phi += (1.0 - t) * f;
+    }
+    if (t > 0.0) {
+        vec3 share = face_shares(n);
+        for (int a = 0; a < 3; a++) {
+            if (share[a] > 0.0) {
+                vec3 axis = vec3(0.0);
+                axis[a] = sign(n[a]);
+                vec3 f = emitter_phi(emitter, p, axis);
+                cosine += t * share[a] * dot(axis, f);
+                phi += t * share[a] * f;
+            }
         }
     }
     if (cosine <= 0.0) {
@@ -236,6 +279,7 @@ void main() {
     }
     // Other voxels whose normals cancel face every way.
     n = len > 0.2 ? n / len : vec3(0.0, 1.0, 0.0);
+    float coherence = min(len, 1.0);
     // Surfaces are two-sided: the voxel keeps the face that receives more light (emitters
     // their winding face), and its normal is turned to that face so that the filter
     // shows this radiance only to cones that look at the face. Turned exactly, so that
@@ -243,12 +287,12 @@ void main() {
     vec3 front = vec3(0.0);
     vec3 back = vec3(0.0);
     for (uint i = 0u; i < frame.light_count; i++) {
-        front += voxel_irradiance(lights[i], p, n);
-        back += voxel_irradiance(lights[i], p, -n);
+        front += voxel_irradiance(lights[i], p, n, coherence);
+        back += voxel_irradiance(lights[i], p, -n, coherence);
     }
     for (uint i = 0u; i < vct.emitter_count; i++) {
-        front += voxel_emitter_irradiance(vct_emitters[i], p, n);
-        back += voxel_emitter_irradiance(vct_emitters[i], p, -n);
+        front += voxel_emitter_irradiance(vct_emitters[i], p, n, coherence);
+        back += voxel_emitter_irradiance(vct_emitters[i], p, -n, coherence);
     }
     bool back_lit = dot(back, vec3(1.0)) > dot(front, vec3(1.0)) && all(equal(emission, vec3(0.0)));
     vec3 e = len > 0.2 ? (back_lit ? back : front) : front + back;
