@@ -54,7 +54,7 @@ void plane_directions(vec3 n, out vec3 t1, out vec3 t2) {
 // light lies deeper or shallower than p by the plane's slope, which one depth for every
 // tap would take for a shadow (acne) or, offset enough to avoid that, for light. The
 // plane is the surface the shadow map rasterized, not the shading normal's: a normal map
-// tilts that far off it (the direct light of a normal-mapped floor 17 % off the path
+// tilts that far off it (the direct light of a normal-mapped floor 16.5 % off the path
 // tracer's, `normal_maps_and_lobe_match_the_rasterized_direct_light`).
 // What is left, the bilinear footprint of each tap reaching a texel beyond it, is the
 // rasterizer's slope-scaled bias's (ShadowPass, 1.5 texels' worth of slope), so a point
@@ -62,7 +62,7 @@ void plane_directions(vec3 n, out vec3 t1, out vec3 t2) {
 // scored worse against the path tracer's direct light on all four references tried). A
 // constant two texels, without the plane, lit the rim of Sponza's planters through the
 // leaves lying on it (its direct light 3.45 times the path tracer's with the sun's map at
-// 8192; 1.91 with half a texel and the plane; BENCHMARKS.md, session 40).
+// 8192; 2.06 with half a texel and the plane; BENCHMARKS.md, session 40).
 float shadow_visibility(GpuLight light, vec3 p, vec3 n, vec3 t1, vec3 t2, float offset_texels, float extra_offset,
                         int pcf_radius) {
     if (light.shadow_view_count == 0u) {
@@ -73,9 +73,9 @@ float shadow_visibility(GpuLight light, vec3 p, vec3 n, vec3 t1, vec3 t2, float 
     vec3 q = p + n * (offset_texels * texel_world + extra_offset);
     vec3 ndc = shadow_ndc(view, q);
     // The plane's depth per texel across the view, from a step of a texel along each
-    // direction: the depth's change over the texels' change (one tap needs none). The changes are
-    // taken in the view's own coordinates, not the atlas layer's, whose larger values
-    // would round them (by up to 5e-4 of a texel in a layer of 4096).
+    // direction: the depth's change over the texels' change (one tap needs none). The
+    // changes are taken in the view's own coordinates, not the atlas layer's, whose
+    // larger values would round them (by up to 5e-4 of a texel in a layer of 4096).
     vec2 slope = vec2(0.0);
     if (pcf_radius > 0) {
         vec3 texels = vec3(vec2(0.5 * float(view.resolution)), 1.0);

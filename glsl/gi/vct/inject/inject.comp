@@ -125,8 +125,8 @@ bool segment_meets_box(vec3 p, vec3 d, float dist, vec3 lo, vec3 hi) {
 // Whether the direct light of the voxel at p can differ from when it was last shaded
 // (the lights and shadow views are the same): only where the path to a light passes
 // the region where moving meshes were or are. The region grows by what the lookups
-// reach beyond that path: the shadow lookup's normal offset (two texels and up to 0.87 of a
-// voxel) and its bilinear taps (a texel and a half), or the voxel ray-march's start
+// reach beyond that path: the shadow lookup's normal offset (two texels and up to 0.87
+// of a voxel) and its bilinear taps (a texel and a half), or the voxel ray-march's start
 // two voxels out and its cells around the ray; at p's distance a shadow texel is at
 // least as wide as where the path meets the region.
 bool light_may_change(vec3 p) {
