@@ -937,7 +937,8 @@ mod tests {
         assert_eq!(
             gi.store,
             Store::Dense {
-                filter: DirectionalFilter::Rows
+                filter: DirectionalFilter::Rows,
+                planes: false,
             }
         );
         let octree = [
@@ -950,6 +951,31 @@ mod tests {
         ];
         let error = parse(&octree).unwrap_err().to_string();
         assert!(error.contains("needs --gi dense"), "{error}");
+    }
+
+    #[test]
+    fn plane_occlusion_needs_the_dense_grid_by_pairs_and_snapped_cones() {
+        let parse = |args: &[&str]| render(args, &GiOverrides::default());
+        let gi = cone_tracing(parse(&["voxcone", "render", "--plane-occlusion"]).unwrap());
+        assert_eq!(
+            gi.store,
+            Store::Dense {
+                filter: DirectionalFilter::Pairs,
+                planes: true,
+            }
+        );
+        for (extra, cause) in [
+            (&["--gi", "octree"][..], "needs --gi dense"),
+            (
+                &["--directional-filter", "rows"][..],
+                "needs --directional-filter pairs",
+            ),
+            (&["--quality", "fast"][..], "needs snapped cones"),
+        ] {
+            let args = [&["voxcone", "render", "--plane-occlusion"][..], extra].concat();
+            let error = parse(&args).unwrap_err().to_string();
+            assert!(error.contains(cause), "{extra:?}: {error}");
+        }
     }
 
     #[test]

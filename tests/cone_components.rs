@@ -277,6 +277,23 @@ fn furnace_inside_the_grid_within_two_percent() {
     }
 }
 
+/// With `--plane-occlusion`: a cone's disc is counted as blocked by a wall it runs towards
+/// only as far as the segment beyond the wall's plane, so the walls' cells before the
+/// crossing no longer close it, and the rest of the disc, which crosses the wall further
+/// on, is counted past the crossing where the cells are empty (the box's outside).
+#[test]
+#[ignore = "issue 20: 0.985, 0.961 and 0.948 at 64³, 128³ and 256³ (0.993, 0.985 and 0.978 counting every crossing, where the images lose more than they gain; 0.971, 0.945 and 0.941 counting none)"]
+fn furnace_inside_the_grid_within_two_percent_with_plane_occlusion() {
+    let shares = furnace_inside_the_grid(
+        "components_furnace_inside_planes",
+        &["--plane-occlusion"],
+        &[64, 128, 256],
+    );
+    for share in shares {
+        assert!((share - 1.0).abs() <= 0.02, "{share}");
+    }
+}
+
 /// Two rooms side by side in a box 4 x 2 x 2: the left one's walls emit 1, the right
 /// one's are black, and a white quad in the right room faces the left one. The light
 /// it gathers through a wall between them (two-sided, no thickness, inside one voxel
@@ -760,6 +777,18 @@ fn wall_on_a_lit_floor_matches_the_path_tracer_with_snapped_cones() {
 #[ignore = "issue 20: 1.15 at 0.03 above the floor, 1.13 at 0.06, 1.10 at 0.1, 1.03 to 1.08 above (64³)"]
 fn wall_on_a_lit_floor_matches_the_path_tracer() {
     wall_on_a_lit_floor_matches_the_path_tracer_with("components_corner_lattice", &[]);
+}
+
+/// With `render`'s default cones and `--plane-occlusion`: each cell keeps its surface
+/// plane, and the floor the cones run beside counts once, as the growing segment of their
+/// discs beyond it, not cell after cell (measured 0.96 at 0.03 above the floor, 1.01 to
+/// 1.05 above, where the default gives 1.15 and 1.03 to 1.10).
+#[test]
+fn wall_on_a_lit_floor_matches_the_path_tracer_with_plane_occlusion() {
+    wall_on_a_lit_floor_matches_the_path_tracer_with(
+        "components_corner_planes",
+        &["--plane-occlusion"],
+    );
 }
 
 /// The heights above the floor the corner's tests measure at.

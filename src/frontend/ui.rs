@@ -484,9 +484,11 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             let mut rows = matches!(
                 vct.store,
                 Store::Dense {
-                    filter: DirectionalFilter::Rows
+                    filter: DirectionalFilter::Rows,
+                    ..
                 }
             );
+            let mut planes = matches!(vct.store, Store::Dense { planes: true, .. });
             settle(ui.add_enabled(
                 !snapped_now,
                 egui::Checkbox::new(&mut wide, "wide steps by level"),
@@ -509,6 +511,20 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                      averaged (the dense grid only); off: children in pairs",
                 ),
             );
+            // The planes need the dense grid by pairs and snapped cones: cleared with
+            // them, so that the panel is never left with a refusal.
+            let planes_possible = !octree && !rows && (snapped || lattice);
+            settle(
+                ui.add_enabled(
+                    planes_possible,
+                    egui::Checkbox::new(&mut planes, "plane occlusion"),
+                )
+                .on_hover_text(
+                    "each cell keeps its surface plane, and a plane the cones run beside \
+                     counts as the same rays from cell to cell (the dense grid by pairs, \
+                     snapped cones)",
+                ),
+            );
             egui::ComboBox::from_label("voxelizer")
                 .selected_text(format!("{voxelizer:?}"))
                 .show_ui(ui, |ui| {
@@ -529,6 +545,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             } else {
                 DirectionalFilter::Pairs
             };
+            args.plane_occlusion = planes && planes_possible;
             if voxelizer != vct.voxelizer {
                 args.voxelizer = voxelizer;
             }

@@ -132,10 +132,17 @@ int major_axis(vec3 m) {
 // composited behind `acc` for a path of `footprints`; with `ao_volume` (0..5), the
 // ambient occlusion's own opacity from that volume at `uvw`, weighted down with the
 // distance `dist` (trace_cone).
-void composite(vec4 s, float footprints, int ao_volume, vec3 uvw, float lod, float dist, inout vec4 acc,
-               inout float ao, inout float ao_alpha) {
-    float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), footprints);
-    vec3 rgb = s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0);
+// With `--plane-occlusion` (march_cells): `limit` (plane_increment: x the most opacity
+// a surface plane allows here, y how planar the cells are) caps the sample's opacity in
+// that proportion, (1, 0) for none; and it is raised to at least `least`, that part with
+// the radiance `beyond` (a plane the cone has crossed, whose rays meet it further on).
+// Returns the opacity composited.
+float composite(vec4 s, float footprints, vec2 limit, float least, vec3 beyond, int ao_volume, vec3 uvw, float lod,
+                float dist, inout vec4 acc, inout float ao, inout float ao_alpha) {
+    float own = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), footprints);
+    own -= limit.y * max(own - limit.x, 0.0);
+    float a = max(own, least);
+    vec3 rgb = (s.a > 1e-4 ? s.rgb * (own / s.a) : vec3(0.0)) + beyond * (a - own);
     acc.rgb += (1.0 - acc.a) * rgb;
     acc.a += (1.0 - acc.a) * a;
     if (ao_volume >= 0) {
@@ -144,6 +151,77 @@ void composite(vec4 s, float footprints, int ao_volume, vec3 uvw, float lod, flo
         ao += (1.0 - ao_alpha) * o / (1.0 + dist / vct.ao_distance);
         ao_alpha += (1.0 - ao_alpha) * o;
     }
+    return a;
+}
+
+// A surface plane a snapped cone has met (`--plane-occlusion`, plane_increment): xyz its
+// normal and w its constant (in grid units less 0.5), the share of the cone's disc
+// counted as blocked by it so far, its radiance as the cone saw it, and whether the
+// cone's axis has crossed it.
+struct HeldPlane {
+    vec4 plane;
+    float share;
+    vec3 radiance;
+    bool crossed;
+};
+
+// The share of a cone's disc beyond `plane` (xyz normal, w constant), a circular segment:
+// the disc of `radius` about the axis point `axis`, the cone leaving `origin` along `dir`
+// (grid units less 0.5).
+float disc_segment(vec4 plane, vec3 axis, vec3 origin, vec3 dir, float radius) {
+    float start_side = dot(plane.xyz, origin) - plane.w;
+    float offset = (dot(plane.xyz, axis) - plane.w) * (start_side < 0.0 ? -1.0 : 1.0);
+    float across = radius * sqrt(max(1.0 - dot(plane.xyz, dir) * dot(plane.xyz, dir), 1e-4));
+    float u = clamp(offset / max(across, 1e-6), -1.0, 1.0);
+    return (acos(u) - u * sqrt(1.0 - u * u)) / 3.14159265;
+}
+
+// Surface planes seen by a snapped cone (`--plane-occlusion`): a plane beside the cone
+// blocks the share of its disc beyond the plane, a circular segment that grows as the
+// disc widens, and it is the same rays in every cell that holds the plane. Composited cell
+// after cell as if uncorrelated, an edge-on floor beside the cone closed it entirely
+// (Loubet & Neyret 2018; the corner of BENCHMARKS.md, sessions 36 and 37). So a cell's
+// plane (DENSE_PLANE_SLOT, read at `uvw` and `level`) adds at most what its segment grew
+// since the cone last met the same plane (`held`); `axis` is the cone's axis point at the
+// end of the cell's stretch, `radius` the cone's there, `origin` its start, `cell` the
+// level's cell (grid units less 0.5). Returns (the most opacity the plane allows, the
+// cells' planarity: |mean opacity x normal| / mean opacity, 1 where the cells' plane is
+// the held one).
+vec3 plane_increment(vec3 uvw, float level, vec3 axis, vec3 origin, vec3 dir, float radius, float cell,
+                     float opacity, inout HeldPlane held) {
+    vec4 plane;
+    float coverage;
+    sample_plane(uvw, level, plane, coverage);
+    float len = length(plane.xyz);
+    if (len < 1e-4 || coverage < 1e-4) {
+        return vec3(1.0, 0.0, 0.0);
+    }
+    float planarity = clamp(len / coverage, 0.0, 1.0);
+    plane /= len;
+    float share = disc_segment(plane, axis, origin, dir, radius);
+    // The axis crosses the plane where the cells along it hold the surface (`opacity`,
+    // the sample's), not past a surface's edge, and the cone sees its face: seen from
+    // behind, a surface hides from the cone (anisotropic.glsl, facing).
+    bool crossing = share >= 0.5 && opacity >= 0.5 && dot(plane.xyz, dir) < 0.125;
+    // The same plane as the held one: normals within 26 degrees, constants within a cell.
+    if (dot(plane.xyz, held.plane.xyz) <= 0.9 || abs(plane.w - held.plane.w) >= cell) {
+        // A plane met for the first time is composited as it is (nothing before blocked
+        // the same rays), and what it blocks is held for the cells after.
+        if (planarity <= 0.5) {
+            return vec3(1.0, 0.0, 0.0);
+        }
+        held = HeldPlane(plane, 0.0, vec3(0.0), crossing);
+        return vec3(1.0, 0.0, 1.0);
+    }
+    if (share >= 0.5) {
+        // The axis crosses the plane by the cell's end: the cells composite as they are,
+        // and the rest of the disc, which crosses the plane further on where the cells
+        // beyond need not hold it (empty space behind a wall, the grid's face), is
+        // counted as its segment grows (march_cells).
+        held.crossed = held.crossed || crossing;
+        return vec3(1.0, 0.0, 0.0);
+    }
+    return vec3(max(share - held.share, 0.0) / max(1.0 - held.share, 1e-4), planarity, 1.0);
 }
 
 // The whole level a snapped cone reads at `dist` along its axis, `height` above its
@@ -214,6 +292,8 @@ vec4 march_cells(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surf
     vec4 acc = vec4(0.0);
     float ao = 0.0;
     float ao_alpha = 0.0;
+    float grid = voxel * cells;
+    HeldPlane held = HeldPlane(vec4(0.0), 0.0, vec3(0.0), false);
     float dist = voxel;
     float lod = snapped_level(dist, tan_half, rise * dist + start_height, clear, min_lod, top);
     bool at_face = false;
@@ -235,7 +315,29 @@ vec4 march_cells(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surf
         // Cones that never read the base level (min_lod >= 1, the diffuse ones) skip its
         // fetches: the branch is on a constant once inlined.
         vec4 s = min_lod >= 1.0 ? sample_directional_volumes(uvw, dir, lod - 1.0) : sample_voxels(uvw, dir, lod);
-        composite(s, footprints, ao_volume, uvw, lod, dist, acc, ao, ao_alpha);
+        vec3 limit = vec3(1.0, 0.0, 0.0);
+        float least = 0.0;
+        if (PLANE_OCCLUSION && !at_face && lod >= 1.0) {
+            // What the plane blocks by the end of the cell's stretch of the axis.
+            float end = dist + chord * cell * voxel;
+            vec3 axis = (origin + dir * end - vct.origin.xyz) / grid - 0.5;
+            vec3 start_point = (origin - vct.origin.xyz) / grid - 0.5;
+            float radius = tan_half * end / grid;
+            limit = plane_increment(uvw, lod - 1.0, axis, start_point, dir, radius, cell / cells, s.a, held);
+            if (held.crossed) {
+                float share = disc_segment(held.plane, axis, start_point, dir, radius);
+                least = max(share - held.share, 0.0) / max(1.0 - held.share, 1e-4);
+            }
+        }
+        float added = composite(s, footprints, limit.xy, least, held.radiance, ao_volume, uvw, lod, dist, acc, ao,
+                                ao_alpha);
+        if (limit.z > 0.0 || held.crossed) {
+            // The held plane's segment grows by what this cell added of it.
+            held.share += (1.0 - held.share) * (held.crossed ? least : min(added, limit.x));
+            if (limit.z > 0.0 && s.a > 0.05) {
+                held.radiance = s.rgb / s.a;
+            }
+        }
         if (at_face) {
             break;
         }
@@ -314,7 +416,7 @@ vec4 trace_cone(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surfa
         float exit_fraction = leaving ? grid_exit(uvw, next_uvw) : 1.0;
         float path = distance(next_uvw, uvw) * vct.origin.w * float(vct.resolution) * exit_fraction;
         float footprints = at_face ? GRID_FACE_PATH : path / footprint;
-        composite(s, footprints, ao_volume, uvw, lod, dist, acc, ao, ao_alpha);
+        composite(s, footprints, vec2(1.0, 0.0), 0.0, vec3(0.0), ao_volume, uvw, lod, dist, acc, ao, ao_alpha);
         if (at_face) {
             break;
         }

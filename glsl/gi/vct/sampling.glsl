@@ -16,6 +16,10 @@ layout(set = SET_GI, binding = BINDING_VCT_DIRECTIONAL) uniform sampler3D voxel_
 // bind (see SPEC_SNAPPED_CONES).
 layout(constant_id = SPEC_SNAPPED_CONES) const bool SNAPPED_CONES = false;
 
+// `--plane-occlusion` (cones.glsl, plane_increment; the dense grid's DENSE_PLANE_SLOT),
+// fixed when the pipeline is made, for the reason SNAPPED_CONES is.
+layout(constant_id = SPEC_PLANE_OCCLUSION) const bool PLANE_OCCLUSION = false;
+
 // Along one axis, the index of the cell, of `cells` across the grid, that holds the
 // texture coordinate `u` (`--snapped-cones`).
 float cell_holding(float u, float cells) {
@@ -45,12 +49,13 @@ void sample_base_snapped(vec3 uvw, out vec4 sx, out vec4 sy, out vec4 sz) {
     sz = textureLod(voxel_radiance, vec3(uvw.xy, cell_centre(uvw.z, cells)), 0.0);
 }
 
-// Where `uvw` of the directional volume d (+X -X +Y -Y +Z -Z) lies in their texture. The
-// six sit side by side along x, each in the middle of a slot twice its width whose
+// Where `uvw` of the directional volume d (+X -X +Y -Y +Z -Z, with `--plane-occlusion`
+// then the planes and coverage) lies in their texture. They sit side by side along x, each in the middle of a slot twice its width whose
 // margins repeat its edge voxels (filter.comp), so that filtering clamps at the cube's
 // faces as at the texture's and never mixes two directions, at every level alike.
 vec3 directional_slot(int d, vec3 uvw) {
-    return vec3((float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / 6.0, uvw.yz);
+    float slots = float(DENSE_DIRECTIONAL_SLOTS + (PLANE_OCCLUSION ? DENSE_PLANE_SLOTS : 0u));
+    return vec3((float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / slots, uvw.yz);
 }
 
 // The directional volume d at `uvw` and mip `level`, one trilinear fetch blending two
@@ -58,6 +63,13 @@ vec3 directional_slot(int d, vec3 uvw) {
 vec4 sample_directional(int d, vec3 uvw, float level) {
     float l = clamp(level, 0.0, float(vct.directional_levels) - 1.0);
     return textureLod(voxel_directional, directional_slot(d, uvw), l);
+}
+
+// The surface plane and coverage of the cells at `uvw` and whole mip `level`
+// (DENSE_PLANE_SLOT, dense/filter.comp), trilinear: the plane premultiplied by coverage.
+void sample_plane(vec3 uvw, float level, out vec4 plane, out float coverage) {
+    plane = textureLod(voxel_directional, directional_slot(int(DENSE_PLANE_SLOT), uvw), level);
+    coverage = textureLod(voxel_directional, directional_slot(int(DENSE_COVERAGE_SLOT), uvw), level).r;
 }
 
 // The directional volume d at `uvw` and whole mip `level`, read at the centre of the cell
@@ -161,6 +173,12 @@ vec4 read_interior(BrickSample s, int d) {
     vec3 texel = vec3(brick_origin(s.brick, counters.interior_pool_side, OCTREE_RADIANCE_BRICK)) + 1.0 + s.local;
     texel.x += float(d) * edge;
     return textureLod(voxel_directional, texel / vec3(6.0 * edge, edge, edge), 0.0);
+}
+
+// The octree keeps no planes: every cell's opacity is composited as uncorrelated.
+void sample_plane(vec3 uvw, float level, out vec4 plane, out float coverage) {
+    plane = vec4(0.0);
+    coverage = 0.0;
 }
 
 vec4 sample_base(vec3 uvw) {

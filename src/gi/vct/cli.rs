@@ -127,6 +127,11 @@ pub struct VctArgs {
     /// How the dense grid's directional levels are filtered from the voxels
     #[arg(long, value_enum, default_value_t)]
     pub directional_filter: DirectionalFilter,
+    /// Keep each cell's surface plane, and count a plane the snapped cones run beside as
+    /// the same rays from cell to cell (correlated occlusion; the dense grid filtered by
+    /// pairs, with snapped cones)
+    #[arg(long)]
+    pub plane_occlusion: bool,
 }
 
 impl VctArgs {
@@ -159,6 +164,7 @@ impl VctArgs {
                 "--directional-filter",
             ),
             (self.sampled_emitters.is_some(), "--sampled-emitters"),
+            (self.plane_occlusion, "--plane-occlusion"),
         ]
         .into_iter()
         .filter_map(|(set, flag)| set.then_some(flag))
@@ -319,8 +325,24 @@ impl VctArgs {
                     "--directional-filter rows needs --gi dense: the octree filters by pairs only"
                 )
             }
-            (false, filter) => Store::Dense { filter },
+            (false, filter) => Store::Dense {
+                filter,
+                planes: self.plane_occlusion,
+            },
         };
+        // The planes are the dense grid's, filtered by pairs, and only the snapped cones'
+        // march reads them (cones.glsl, plane_increment).
+        if self.plane_occlusion {
+            if octree {
+                bail!("--plane-occlusion needs --gi dense: the octree keeps no planes");
+            }
+            if filter == DirectionalFilter::Rows {
+                bail!("--plane-occlusion needs --directional-filter pairs: the rows filter keeps no planes");
+            }
+            if !cones.snapped_cones {
+                bail!("--plane-occlusion needs snapped cones (--snapped-cones or --lattice-cones): only their march reads the planes");
+            }
+        }
         let voxels = match (octree, self.octree_depth, voxels) {
             (true, Some(depth), _) => {
                 check_depth(depth)?;

@@ -244,26 +244,30 @@ pub(crate) fn bind_cone_samples<'a>(
 
 /// What every pipeline of voxel cone tracing is made with: the layouts of sets 0 to 3,
 /// and the specialization constants (`SPEC_OCTREE_DEPTH`, which the dense grid's shaders
-/// do not declare and so ignore, `SPEC_SNAPPED_CONES` and `SPEC_LATTICE_CONES`).
+/// do not declare and so ignore, `SPEC_SNAPPED_CONES`, `SPEC_LATTICE_CONES` and
+/// `SPEC_PLANE_OCCLUSION`).
 #[derive(Clone, Copy)]
 pub struct PipelineBase {
     pub sets: [vk::DescriptorSetLayout; 4],
-    constants: [u32; 3],
+    constants: [u32; 4],
 }
 
 impl PipelineBase {
-    /// For the cone tracer over `grid` with `cones`, whose store's set 3 has the layout
+    /// For the cone tracer over `grid` with `cones` in `store`, whose set 3 has the layout
     /// `store_set`.
     fn new(
         set_layouts: &[vk::DescriptorSetLayout; 3],
         store_set: vk::DescriptorSetLayout,
         grid: &Grid,
         cones: &ConeSettings,
+        store: Store,
     ) -> Self {
-        let mut constants = [0; 3];
+        let mut constants = [0; 4];
         constants[layout::SPEC_OCTREE_DEPTH as usize] = grid.resolution.ilog2();
         constants[layout::SPEC_SNAPPED_CONES as usize] = u32::from(cones.snapped_cones);
         constants[layout::SPEC_LATTICE_CONES as usize] = cones.lattice_cones;
+        constants[layout::SPEC_PLANE_OCCLUSION as usize] =
+            u32::from(matches!(store, Store::Dense { planes: true, .. }));
         Self {
             sets: [set_layouts[0], set_layouts[1], set_layouts[2], store_set],
             constants,
@@ -369,7 +373,7 @@ impl<S: VoxelStore> ConeTracing<S> {
             // and filtering towards a border would thin every wall there.
             &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::CLAMP_TO_EDGE),
         )?;
-        let base = PipelineBase::new(&set_layouts, sets.layout, &grid, &cones);
+        let base = PipelineBase::new(&set_layouts, sets.layout, &grid, &cones, settings.store);
         let store = S::new(
             ctx,
             scene,

@@ -94,18 +94,13 @@ fn mark(triangles: &[[Vec3; 3]], grid: &Grid, grow: f32) -> Vec<bool> {
 /// travelling along `direction`: all of it facing the cone, half edge-on, none from
 /// behind; a two-sided voxel (alpha 0) keeps its opacity from behind (half edge-on).
 pub fn seen_facing(packed: u32, value: [f32; 4], direction: usize) -> [f32; 4] {
-    let n = Vec3::new(
-        (packed & 0xff) as f32,
-        ((packed >> 8) & 0xff) as f32,
-        ((packed >> 16) & 0xff) as f32,
-    ) / 127.5
-        - 1.0;
-    if n.length() < 0.2 {
+    let n = unpacked_normal(packed);
+    if n == Vec3::ZERO {
         return value;
     }
     let mut towards_viewer = Vec3::ZERO;
     towards_viewer[direction / 2] = if direction % 2 == 0 { -1.0 } else { 1.0 };
-    let c = n.normalize().dot(towards_viewer);
+    let c = n.dot(towards_viewer);
     let w = (0.5 + 4.0 * c).clamp(0.0, 1.0);
     let cover = if packed >> 24 == 0 {
         (0.5 + 4.0 * c.abs()).clamp(0.0, 1.0)
@@ -113,6 +108,78 @@ pub fn seen_facing(packed: u32, value: [f32; 4], direction: usize) -> [f32; 4] {
         w
     };
     [value[0] * w, value[1] * w, value[2] * w, value[3] * cover]
+}
+
+/// The unit normal of a packed RGBA8 voxel normal, zero where it is shorter than 0.2 (no
+/// single direction), as `glsl/gi/vct/anisotropic.glsl` and `dense/filter.comp` read it.
+fn unpacked_normal(packed: u32) -> Vec3 {
+    let n = Vec3::new(
+        (packed & 0xff) as f32,
+        ((packed >> 8) & 0xff) as f32,
+        ((packed >> 16) & 0xff) as f32,
+    ) / 127.5
+        - 1.0;
+    if n.length() < 0.2 {
+        Vec3::ZERO
+    } else {
+        n.normalize()
+    }
+}
+
+/// The first level of the cells' surface planes and coverage (`--plane-occlusion`) from
+/// the base level's opacity and packed normals (resolution n): per cell of 2x2x2 voxels,
+/// the mean of opacity times (normal, normal . centre), the centre in grid units less 0.5,
+/// and the mean opacity.
+pub fn filter_planes_base(opacity: &[f32], normals: &[u32], n: u32) -> (Vec<[f32; 4]>, Vec<f32>) {
+    let children =
+        |p: UVec3| (0..8u32).map(move |i| p * 2 + UVec3::new(i & 1, (i >> 1) & 1, i >> 2));
+    let half = n / 2;
+    let mut planes = Vec::new();
+    let mut coverage = Vec::new();
+    for z in 0..half {
+        for y in 0..half {
+            for x in 0..half {
+                let mut plane = [0.0f32; 4];
+                let mut cover = 0.0;
+                for c in children(UVec3::new(x, y, z)) {
+                    let a = opacity[linear(n, c)];
+                    let normal = unpacked_normal(normals[linear(n, c)]);
+                    let centre = (c.as_vec3() + 0.5) / n as f32 - 0.5;
+                    plane[0] += a * normal.x;
+                    plane[1] += a * normal.y;
+                    plane[2] += a * normal.z;
+                    plane[3] += a * normal.dot(centre);
+                    cover += a;
+                }
+                planes.push(plane.map(|v| v / 8.0));
+                coverage.push(cover / 8.0);
+            }
+        }
+    }
+    (planes, coverage)
+}
+
+/// The next level of the planes (or the coverage, in the first channel) from the level
+/// below (resolution n -> n/2): the mean of each cell's 2x2x2 children.
+pub fn filter_mean(level: &[[f32; 4]], n: u32) -> Vec<[f32; 4]> {
+    let half = n / 2;
+    let mut out = Vec::new();
+    for z in 0..half {
+        for y in 0..half {
+            for x in 0..half {
+                let mut sum = [0.0f32; 4];
+                for i in 0..8u32 {
+                    let c = UVec3::new(x, y, z) * 2 + UVec3::new(i & 1, (i >> 1) & 1, i >> 2);
+                    let v = level[linear(n, c)];
+                    for k in 0..4 {
+                        sum[k] += v[k];
+                    }
+                }
+                out.push(sum.map(|v| v / 8.0));
+            }
+        }
+    }
+    out
 }
 
 /// Premultiplied RGBA `front` composited over `back`: what a ray sees passing through

@@ -15,6 +15,9 @@ pub enum Store {
     Dense {
         /// How its directional levels are filtered.
         filter: DirectionalFilter,
+        /// Whether the filter keeps each cell's surface plane, which the snapped cones
+        /// count as the same rays from cell to cell (`--plane-occlusion`).
+        planes: bool,
     },
     /// A sparse voxel octree of the same effective resolution (`--gi octree`).
     Octree {

@@ -11,7 +11,7 @@ use ash::vk;
 
 use super::{Volumes, RADIANCE_FORMAT};
 use crate::gi::vct::DirectionalFilter;
-use crate::gpu_layout::{self as layout, FilterRowsPush};
+use crate::gpu_layout::{self as layout, FilterPush, FilterRowsPush};
 use crate::vk::{
     compute_to_compute, groups_3d, to_compute_write, Binding, Context, DescriptorSets, Image,
     ImageDesc, OwnedView, Pipeline, SetWriter,
@@ -23,6 +23,8 @@ pub struct FilterPass {
     /// k-1 (by pairs) or the rows of level k-1 (by rows).
     level_sets: Vec<vk::DescriptorSet>,
     by_rows: bool,
+    /// By pairs: also the cells' surface planes (`--plane-occlusion`).
+    planes: bool,
     _sets: DescriptorSets,
     /// Per-level views of the directional texture, referenced by the sets.
     _views: Vec<OwnedView>,
@@ -32,13 +34,15 @@ pub struct FilterPass {
 }
 
 impl FilterPass {
-    /// `set_layouts` are those of sets 0 and 1 (unused, but set 2 sits after them); `n`
-    /// the grid's resolution.
+    /// `set_layouts` are those of sets 0 and 1 (unused, but set 2 sits after them);
+    /// `planes` whether the filter by pairs keeps the cells' planes; `n` the grid's
+    /// resolution.
     pub(super) fn new(
         ctx: &Arc<Context>,
         set_layouts: [vk::DescriptorSetLayout; 2],
         volumes: &Volumes,
         filter: DirectionalFilter,
+        planes: bool,
         n: u32,
     ) -> Result<Self> {
         let by_rows = filter == DirectionalFilter::Rows;
@@ -80,7 +84,10 @@ impl FilterPass {
                 std::mem::size_of::<FilterRowsPush>() as u32,
             )
         } else {
-            (crate::vk::shaders::GI_VCT_DENSE_FILTER_COMP, 4)
+            (
+                crate::vk::shaders::GI_VCT_DENSE_FILTER_COMP,
+                std::mem::size_of::<FilterPush>() as u32,
+            )
         };
         let pipeline = Pipeline::compute(
             ctx,
@@ -117,6 +124,7 @@ impl FilterPass {
             pipeline,
             level_sets,
             by_rows,
+            planes,
             _sets: sets,
             _views: views,
             rows,
@@ -141,7 +149,11 @@ impl FilterPass {
                     };
                     self.pipeline.push(cmd, stages, &push);
                 } else {
-                    self.pipeline.push(cmd, stages, &(level as u32));
+                    let push = FilterPush {
+                        level: level as u32,
+                        planes: u32::from(self.planes),
+                    };
+                    self.pipeline.push(cmd, stages, &push);
                 }
                 let size = (n >> (level + 1)).max(1);
                 self.pipeline.dispatch(

@@ -66,7 +66,8 @@ fn dense_keeps_static_sums(scene: &Scene, full_update: bool) -> bool {
 const RADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
 impl Volumes {
-    fn new(ctx: &Arc<Context>, n: u32, static_copies: bool) -> Result<Self> {
+    /// `planes`: the directional texture has the planes' slots (`--plane-occlusion`).
+    fn new(ctx: &Arc<Context>, n: u32, static_copies: bool, planes: bool) -> Result<Self> {
         // Every volume can be copied out, for the checks against the CPU twins.
         let packed_usage = vk::ImageUsageFlags::STORAGE
             | vk::ImageUsageFlags::TRANSFER_DST
@@ -90,7 +91,9 @@ impl Volumes {
             directional_levels(n),
             radiance_usage,
         );
-        directional_desc.extent.width = 6 * DIRECTIONAL_SLOT * (n / 2);
+        let slots =
+            layout::DENSE_DIRECTIONAL_SLOTS + if planes { layout::DENSE_PLANE_SLOTS } else { 0 };
+        directional_desc.extent.width = slots * DIRECTIONAL_SLOT * (n / 2);
         let directional = Image::new(ctx, "voxel radiance directional", directional_desc)?;
         let static_sums = static_copies
             .then(|| sums("static voxel sums"))
@@ -188,11 +191,16 @@ impl VoxelStore for Dense {
     ) -> Result<Self> {
         let (resolution, full_update) = (grid.resolution, settings.full_update);
         let voxelizer = settings.voxelizer;
-        let filter = match settings.store {
-            Store::Dense { filter } => filter,
-            Store::Octree { .. } => DirectionalFilter::Pairs,
+        let (filter, planes) = match settings.store {
+            Store::Dense { filter, planes } => (filter, planes),
+            Store::Octree { .. } => (DirectionalFilter::Pairs, false),
         };
-        let volumes = Volumes::new(ctx, resolution, dense_keeps_static_sums(scene, full_update))?;
+        let volumes = Volumes::new(
+            ctx,
+            resolution,
+            dense_keeps_static_sums(scene, full_update),
+            planes,
+        )?;
         let writer = SetWriter::new(ctx, set)
             .storage_image(layout::BINDING_VCT_ALBEDO, volumes.albedo.view)
             .storage_image(layout::BINDING_VCT_NORMAL, volumes.normal.view)
@@ -253,6 +261,7 @@ impl VoxelStore for Dense {
                 [base.sets[0], base.sets[1]],
                 &volumes,
                 filter,
+                planes,
                 resolution,
             )?,
             compact,

@@ -10,6 +10,7 @@ use super::super::{
 };
 use super::Volume;
 use crate::gi::GiSettings;
+use crate::gpu_layout as layout;
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
@@ -21,6 +22,7 @@ use crate::vk::Context;
 /// The dense grid with the default filter.
 const DENSE: Store = Store::Dense {
     filter: DirectionalFilter::Pairs,
+    planes: false,
 };
 
 /// Renders 64x64 frames of `scene` with `--gi dense --voxels n`, one at each time,
@@ -113,18 +115,31 @@ fn halves(bytes: &[u8]) -> Vec<[f32; 4]> {
         .collect()
 }
 
+/// The voxels' packed RGBA8 normals as downloaded.
+fn packed_normals(renderer: &Renderer) -> Vec<u32> {
+    dense(renderer)
+        .store()
+        .download(Volume::Normal, 0)
+        .unwrap()
+        .chunks_exact(4)
+        .map(|t| u32::from_le_bytes([t[0], t[1], t[2], t[3]]))
+        .collect()
+}
+
+/// One frame of the reference Cornell box (point light) at `n`³ in `store`.
+fn cornell_frame(n: u32, store: Store) -> (Arc<Context>, Renderer) {
+    let path = shared_file("reference/cornell_point.scene.json");
+    let scene = Scene::load(&path, &LoadOptions::REFERENCE).unwrap();
+    render_frames(scene, gi_settings(n, store, false), &[0.0])
+}
+
 /// The base radiance as downloaded, as seen along each of the six directions (weighted
 /// by which way each voxel's lit face looks).
 fn base_seen(renderer: &Renderer) -> Vec<Vec<[f32; 4]>> {
     let gi = dense(renderer).store();
     let base = halves(&gi.download(Volume::Radiance, 0).unwrap());
     assert!(base.iter().any(|v| v[3] > 0.0), "empty radiance volume");
-    let normals: Vec<u32> = gi
-        .download(Volume::Normal, 0)
-        .unwrap()
-        .chunks_exact(4)
-        .map(|t| u32::from_le_bytes([t[0], t[1], t[2], t[3]]))
-        .collect();
+    let normals = packed_normals(renderer);
     (0..6)
         .map(|d| {
             base.iter()
@@ -177,6 +192,71 @@ fn filter_matches_cpu() {
     assert_eq!(ctx.validation_messages(), 0);
 }
 
+/// With `--plane-occlusion`, each level of the cells' planes and coverage equals the CPU
+/// filter applied to the level below as downloaded (the first level: the base opacity
+/// and normals), within half-float rounding; and the planes are planes: most covered
+/// cells of the Cornell box (walls, floor, blocks) hold one, |mean opacity x normal| at
+/// least 0.9 of the mean opacity.
+#[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn filter_planes_match_cpu() {
+    let n = 32;
+    let (ctx, renderer) = cornell_frame(
+        n,
+        Store::Dense {
+            filter: DirectionalFilter::Pairs,
+            planes: true,
+        },
+    );
+    let gi = dense(&renderer).store();
+    let opacity: Vec<f32> = halves(&gi.download(Volume::Radiance, 0).unwrap())
+        .iter()
+        .map(|v| v[3])
+        .collect();
+    let normals = packed_normals(&renderer);
+    let plane_slot = layout::DENSE_PLANE_SLOT as usize;
+    let coverage_slot = layout::DENSE_COVERAGE_SLOT as usize;
+    let (mut planes, coverage) = reference::filter_planes_base(&opacity, &normals, n);
+    let mut coverage: Vec<[f32; 4]> = coverage.iter().map(|&c| [c, 0.0, 0.0, 0.0]).collect();
+    let mut worst = 0.0f32;
+    let (mut covered, mut planar) = (0, 0);
+    let mut size = n / 2;
+    for level in 0..n.trailing_zeros() - 1 {
+        let gpu_planes = halves(&gi.download(Volume::Directional(plane_slot), level).unwrap());
+        let gpu_coverage = halves(
+            &gi.download(Volume::Directional(coverage_slot), level)
+                .unwrap(),
+        );
+        let what = format!("planes level {level}");
+        worst = worst.max(worst_difference(&planes, &gpu_planes, 2.0 / 1024.0, &what));
+        let what = format!("coverage level {level}");
+        worst = worst.max(worst_difference(
+            &coverage,
+            &gpu_coverage,
+            2.0 / 1024.0,
+            &what,
+        ));
+        if level == 0 {
+            for (p, c) in gpu_planes.iter().zip(&gpu_coverage) {
+                if c[0] > 0.05 {
+                    covered += 1;
+                    let len = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+                    planar += usize::from(len >= 0.9 * c[0]);
+                }
+            }
+        }
+        planes = reference::filter_mean(&gpu_planes, size);
+        coverage = reference::filter_mean(&gpu_coverage, size);
+        size /= 2;
+    }
+    eprintln!(
+        "filter's planes: worst relative difference {worst:.2e}; {planar} of {covered} \
+         covered cells planar at the first level"
+    );
+    assert!(2 * planar > covered, "{planar} of {covered} cells planar");
+    assert_eq!(ctx.validation_messages(), 0);
+}
+
 /// With `--directional-filter rows`, each level of each directional volume equals the
 /// filter's definition applied to the base radiance as downloaded (each cell's rows of
 /// voxels, as seen along the direction, composited whole, then averaged), within the
@@ -186,17 +266,14 @@ fn filter_matches_cpu() {
 #[test]
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn filter_by_rows_matches_cpu() {
-    let path = shared_file("reference/cornell_point.scene.json");
-    let scene = Scene::load(&path, &LoadOptions::REFERENCE).unwrap();
     let n = 32;
-    let settings = gi_settings(
+    let (ctx, renderer) = cornell_frame(
         n,
         Store::Dense {
             filter: DirectionalFilter::Rows,
+            planes: false,
         },
-        false,
     );
-    let (ctx, renderer) = render_frames(scene, settings, &[0.0]);
     let gi = dense(&renderer).store();
     let mut worst = 0.0f32;
     let mut thinner = 0;
