@@ -282,7 +282,7 @@ fn furnace_inside_the_grid_within_two_percent() {
 /// crossing no longer close it, and the rest of the disc, which crosses the wall further
 /// on, is counted past the crossing where the cells are empty (the box's outside).
 #[test]
-#[ignore = "issue 20: 0.985, 0.961 and 0.948 at 64³, 128³ and 256³ (0.993, 0.985 and 0.978 counting every crossing, where the images lose more than they gain; 0.971, 0.945 and 0.941 counting none)"]
+#[ignore = "issue 20: 0.988, 0.965 and 0.953 at 64³, 128³ and 256³ (0.993, 0.985 and 0.978 counting every crossing, where the images lose more than they gain; 0.971, 0.945 and 0.941 counting none)"]
 fn furnace_inside_the_grid_within_two_percent_with_plane_occlusion() {
     let shares = furnace_inside_the_grid(
         "components_furnace_inside_planes",

@@ -207,7 +207,8 @@ vec3 plane_increment(vec3 uvw, float level, vec3 axis, vec3 origin, vec3 dir, fl
     if (dot(plane.xyz, held.plane.xyz) <= 0.9 || abs(plane.w - held.plane.w) >= cell) {
         // A plane met for the first time is composited as it is (nothing before blocked
         // the same rays), and what it blocks is held for the cells after.
-        if (planarity <= 0.5) {
+        // A crossed plane stays held: the rest of its rays still meet it.
+        if (planarity <= 0.5 || held.crossed) {
             return vec3(1.0, 0.0, 0.0);
         }
         held = HeldPlane(plane, 0.0, vec3(0.0), crossing);
