@@ -222,7 +222,14 @@ vec3 plane_increment(vec3 uvw, float level, vec3 axis, vec3 origin, vec3 dir, fl
         held.crossed = held.crossed || crossing;
         return vec3(1.0, 0.0, 0.0);
     }
-    return vec3(max(share - held.share, 0.0) / max(1.0 - held.share, 1e-4), planarity, 1.0);
+    // Only a plane the cone runs beside, within 30 degrees of its axis, is read in cell
+    // after cell before the axis reaches it: the disc meets it r s / |n . dir| before the
+    // axis does, in cells of at most r, so more than 1.7 cells there. A plane met more
+    // steeply is crossed within a cell or two, and capping those cells by the segment
+    // left the cells past the crossing, often empty, to stop the rest: a closed box
+    // inside the grid gathered 0.953 of its walls' light at 256³ (0.995 without the cap).
+    float grazing = abs(dot(plane.xyz, dir)) < 0.5 ? planarity : 0.0;
+    return vec3(max(share - held.share, 0.0) / max(1.0 - held.share, 1e-4), grazing, 1.0);
 }
 
 // The whole level a snapped cone reads at `dist` along its axis, `height` above its
