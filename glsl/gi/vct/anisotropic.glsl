@@ -6,6 +6,13 @@
 #ifndef ANISOTROPIC_GLSL
 #define ANISOTROPIC_GLSL
 
+// The unit normal of a base voxel's packed RGBA8 normal (xyz * 127.5 + 127.5), zero
+// where the averaged normals disagree so much that it is shorter than 0.2.
+vec3 unit_voxel_normal(uint packed_normal) {
+    vec3 n = vec3(float(packed_normal & 0xffu), float((packed_normal >> 8) & 0xffu), float((packed_normal >> 16) & 0xffu)) / 127.5 - 1.0;
+    return length(n) < 0.2 ? vec3(0.0) : normalize(n);
+}
+
 // Of a base voxel with packed RGBA8 normal `packed_normal`, the part a cone travelling
 // along `d` sees: all of it when the cone looks at the voxel's lit face, half of it
 // edge-on, none from behind. Opacity is weighted too: without this, a cone leaving a
@@ -20,13 +27,13 @@
 // slab thinner than the voxel, both of whose faces it holds, inject.comp) blocks cones from either side and shows its light
 // only to those that look at its lit face: from behind it is the slab's unlit underside.
 vec4 facing(uint packed_normal, vec4 value, int d) {
-    vec3 n = vec3(float(packed_normal & 0xffu), float((packed_normal >> 8) & 0xffu), float((packed_normal >> 16) & 0xffu)) / 127.5 - 1.0;
-    if (length(n) < 0.2) {
+    vec3 n = unit_voxel_normal(packed_normal);
+    if (n == vec3(0.0)) {
         return value;
     }
     vec3 towards_viewer = vec3(0.0);
     towards_viewer[d / 2] = (d % 2 == 0) ? -1.0 : 1.0;
-    float c = dot(normalize(n), towards_viewer);
+    float c = dot(n, towards_viewer);
     float w = clamp(0.5 + 4.0 * c, 0.0, 1.0);
     if ((packed_normal >> 24) == 0u) {
         return vec4(value.rgb * w, value.a * clamp(0.5 + 4.0 * abs(c), 0.0, 1.0));

@@ -50,9 +50,10 @@ void sample_base_snapped(vec3 uvw, out vec4 sx, out vec4 sy, out vec4 sz) {
 }
 
 // Where `uvw` of the directional volume d (+X -X +Y -Y +Z -Z, with `--plane-occlusion`
-// then the planes and coverage) lies in their texture. They sit side by side along x, each in the middle of a slot twice its width whose
-// margins repeat its edge voxels (filter.comp), so that filtering clamps at the cube's
-// faces as at the texture's and never mixes two directions, at every level alike.
+// then the planes and coverage) lies in their texture. They sit side by side along x,
+// each in the middle of a slot twice its width whose margins repeat its edge voxels
+// (filter.comp), so that filtering clamps at the cube's faces as at the texture's and
+// never mixes two directions, at every level alike.
 vec3 directional_slot(int d, vec3 uvw) {
     float slots = float(DENSE_DIRECTIONAL_SLOTS + (PLANE_OCCLUSION ? DENSE_PLANE_SLOTS : 0u));
     return vec3((float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / slots, uvw.yz);

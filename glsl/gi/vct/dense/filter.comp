@@ -38,9 +38,7 @@ void filter_plane(ivec3 first, int edge, out vec4 plane, out float coverage) {
         ivec3 child = first + ivec3(i & 1, (i >> 1) & 1, i >> 2);
         if (push.level == 0u) {
             float a = imageLoad(base_level, child).a;
-            uint packed = imageLoad(voxel_normal, child).r;
-            vec3 normal = vec3(float(packed & 0xffu), float((packed >> 8) & 0xffu), float((packed >> 16) & 0xffu)) / 127.5 - 1.0;
-            normal = length(normal) < 0.2 ? vec3(0.0) : normalize(normal);
+            vec3 normal = unit_voxel_normal(imageLoad(voxel_normal, child).r);
             vec3 centre = (vec3(child) + 0.5) / n - 0.5;
             plane += a * vec4(normal, dot(normal, centre));
             coverage += a;
