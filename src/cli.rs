@@ -954,7 +954,7 @@ mod tests {
     }
 
     #[test]
-    fn plane_occlusion_needs_the_dense_grid_by_pairs_and_snapped_cones() {
+    fn plane_occlusion_needs_pairs_and_snapped_cones() {
         let parse = |args: &[&str]| render(args, &GiOverrides::default());
         let gi = cone_tracing(parse(&["voxcone", "render", "--plane-occlusion"]).unwrap());
         assert_eq!(
@@ -964,8 +964,15 @@ mod tests {
                 planes: true,
             }
         );
+        let octree = ["voxcone", "render", "--plane-occlusion", "--gi", "octree"];
+        assert_eq!(
+            cone_tracing(parse(&octree).unwrap()).store,
+            Store::Octree {
+                capacities: None,
+                planes: true,
+            }
+        );
         for (extra, cause) in [
-            (&["--gi", "octree"][..], "needs --gi dense"),
             (
                 &["--directional-filter", "rows"][..],
                 "needs --directional-filter pairs",

@@ -17,11 +17,16 @@ fn flip(reference: &Path, test: &Path) -> f32 {
 
 /// The octree at depth 6 and the dense grid at 64³ give the same picture of the Cornell
 /// box, and the octree's is at least as close to the path-traced one: with the default
-/// lookups and with `--snapped-cones`, whose reads the octree's bricks make too.
+/// lookups, with `--snapped-cones`, whose reads the octree's bricks make too, and with
+/// `--plane-occlusion`, whose planes they keep.
 #[test]
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn octree_agrees_with_dense_grid() {
-    for extra in [&[][..], &["--snapped-cones"][..]] {
+    for extra in [
+        &[][..],
+        &["--snapped-cones"][..],
+        &["--snapped-cones", "--plane-occlusion"][..],
+    ] {
         octree_agrees_with_dense_grid_with(extra);
     }
 }

@@ -488,7 +488,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                     ..
                 }
             );
-            let mut planes = matches!(vct.store, Store::Dense { planes: true, .. });
+            let mut planes = vct.store.planes();
             settle(ui.add_enabled(
                 !snapped_now,
                 egui::Checkbox::new(&mut wide, "wide steps by level"),
@@ -511,9 +511,9 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                      averaged (the dense grid only); off: children in pairs",
                 ),
             );
-            // The planes need the dense grid by pairs and snapped cones: cleared with
-            // them, so that the panel is never left with a refusal.
-            let planes_possible = !octree && !rows && (snapped || lattice);
+            // The planes need the filter by pairs and snapped cones: cleared with them,
+            // so that the panel is never left with a refusal.
+            let planes_possible = !rows && (snapped || lattice);
             settle(
                 ui.add_enabled(
                     planes_possible,
@@ -521,8 +521,8 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                 )
                 .on_hover_text(
                     "each cell keeps its surface plane, and a plane the cones run beside \
-                     counts as the same rays from cell to cell (the dense grid by pairs, \
-                     snapped cones)",
+                     counts as the same rays from cell to cell (filtered by pairs, snapped \
+                     cones)",
                 ),
             );
             egui::ComboBox::from_label("voxelizer")

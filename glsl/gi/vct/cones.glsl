@@ -181,7 +181,7 @@ float disc_segment(vec4 plane, vec3 axis, vec3 origin, vec3 dir, float radius) {
 // disc widens, and it is the same rays in every cell that holds the plane. Composited cell
 // after cell as if uncorrelated, an edge-on floor beside the cone closed it entirely
 // (Loubet & Neyret 2018; the corner of BENCHMARKS.md, sessions 36 and 37). So a cell's
-// plane (DENSE_PLANE_SLOT, read at `uvw` and `level`) adds at most what its segment grew
+// plane (PLANE_SLOT, read at `uvw` and `level`) adds at most what its segment grew
 // since the cone last met the same plane (`held`); `axis` is the cone's axis point at the
 // end of the cell's stretch, `radius` the cone's there, `origin` its start, `cell` the
 // level's cell (grid units less 0.5). Returns (the most opacity the plane allows, the

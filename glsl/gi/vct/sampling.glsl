@@ -16,10 +16,6 @@ layout(set = SET_GI, binding = BINDING_VCT_DIRECTIONAL) uniform sampler3D voxel_
 // bind (see SPEC_SNAPPED_CONES).
 layout(constant_id = SPEC_SNAPPED_CONES) const bool SNAPPED_CONES = false;
 
-// `--plane-occlusion` (cones.glsl, plane_increment; the dense grid's DENSE_PLANE_SLOT),
-// fixed when the pipeline is made, for the reason SNAPPED_CONES is.
-layout(constant_id = SPEC_PLANE_OCCLUSION) const bool PLANE_OCCLUSION = false;
-
 // Along one axis, the index of the cell, of `cells` across the grid, that holds the
 // texture coordinate `u` (`--snapped-cones`).
 float cell_holding(float u, float cells) {
@@ -55,8 +51,7 @@ void sample_base_snapped(vec3 uvw, out vec4 sx, out vec4 sy, out vec4 sz) {
 // (filter.comp), so that filtering clamps at the cube's faces as at the texture's and
 // never mixes two directions, at every level alike.
 vec3 directional_slot(int d, vec3 uvw) {
-    float slots = float(DENSE_DIRECTIONAL_SLOTS + (PLANE_OCCLUSION ? DENSE_PLANE_SLOTS : 0u));
-    return vec3((float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / slots, uvw.yz);
+    return vec3((float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / float(directional_slots()), uvw.yz);
 }
 
 // The directional volume d at `uvw` and mip `level`, one trilinear fetch blending two
@@ -67,10 +62,10 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
 }
 
 // The surface plane and coverage of the cells at `uvw` and whole mip `level`
-// (DENSE_PLANE_SLOT, dense/filter.comp), trilinear: the plane premultiplied by coverage.
+// (PLANE_SLOT, dense/filter.comp), trilinear: the plane premultiplied by coverage.
 void sample_plane(vec3 uvw, float level, out vec4 plane, out float coverage) {
-    plane = textureLod(voxel_directional, directional_slot(int(DENSE_PLANE_SLOT), uvw), level);
-    coverage = textureLod(voxel_directional, directional_slot(int(DENSE_COVERAGE_SLOT), uvw), level).r;
+    plane = textureLod(voxel_directional, directional_slot(int(PLANE_SLOT), uvw), level);
+    coverage = textureLod(voxel_directional, directional_slot(int(COVERAGE_SLOT), uvw), level).r;
 }
 
 // The directional volume d at `uvw` and whole mip `level`, read at the centre of the cell
@@ -168,18 +163,13 @@ vec4 read_leaf(BrickSample s) {
 }
 
 // Directional radiance d of an interior brick, trilinear, at a located place. The six
-// directions of a brick sit side by side along x, one pool width apart.
+// directions of a brick sit side by side along x, one pool width apart, and with
+// `--plane-occlusion` the plane and coverage after them (directional_slots).
 vec4 read_interior(BrickSample s, int d) {
     float edge = float(counters.interior_pool_side * OCTREE_RADIANCE_BRICK);
     vec3 texel = vec3(brick_origin(s.brick, counters.interior_pool_side, OCTREE_RADIANCE_BRICK)) + 1.0 + s.local;
     texel.x += float(d) * edge;
-    return textureLod(voxel_directional, texel / vec3(6.0 * edge, edge, edge), 0.0);
-}
-
-// The octree keeps no planes: every cell's opacity is composited as uncorrelated.
-void sample_plane(vec3 uvw, float level, out vec4 plane, out float coverage) {
-    plane = vec4(0.0);
-    coverage = 0.0;
+    return textureLod(voxel_directional, texel / vec3(float(directional_slots()) * edge, edge, edge), 0.0);
 }
 
 vec4 sample_base(vec3 uvw) {
@@ -232,6 +222,32 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
     vec4 near = locate(uvw, fine, a) ? read_interior(a, d) : vec4(0.0);
     vec4 far = (t > 0.0 && locate(uvw, coarse, b)) ? read_interior(b, d) : vec4(0.0);
     return mix(near, far, t);
+}
+
+// The surface plane and coverage of the cells at `uvw` and `level` (PLANE_SLOT,
+// octree/bricks/filter.comp), as the dense grid's: the plane premultiplied by coverage.
+void sample_plane(vec3 uvw, float level, out vec4 plane, out float coverage) {
+    uint fine;
+    uint coarse;
+    float t;
+    level_pair(level, fine, coarse, t);
+    BrickSample s;
+    plane = vec4(0.0);
+    coverage = 0.0;
+    if (locate(uvw, fine, s)) {
+        plane = read_interior(s, int(PLANE_SLOT));
+        coverage = read_interior(s, int(COVERAGE_SLOT)).r;
+    }
+    if (t > 0.0) {
+        vec4 far = vec4(0.0);
+        float far_coverage = 0.0;
+        if (locate(uvw, coarse, s)) {
+            far = read_interior(s, int(PLANE_SLOT));
+            far_coverage = read_interior(s, int(COVERAGE_SLOT)).r;
+        }
+        plane = mix(plane, far, t);
+        coverage = mix(coverage, far_coverage, t);
+    }
 }
 
 // Directional radiance d of an interior brick at a located place at `level`, with

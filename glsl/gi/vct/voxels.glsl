@@ -9,6 +9,15 @@ layout(set = SET_GI, binding = BINDING_VCT_UNIFORMS) uniform VctBlock {
     VctUniforms vct;
 };
 
+// `--plane-occlusion` (cones.glsl, plane_increment; PLANE_SLOT of the directional
+// volumes), fixed when the pipeline is made, for the reason SNAPPED_CONES is.
+layout(constant_id = SPEC_PLANE_OCCLUSION) const bool PLANE_OCCLUSION = false;
+
+// Slots of the directional volumes side by side along x (DIRECTIONAL_SLOTS).
+uint directional_slots() {
+    return DIRECTIONAL_SLOTS + (PLANE_OCCLUSION ? PLANE_SLOTS : 0u);
+}
+
 // RGBA8 packed as r | g << 8 | b << 16 | a << 24, channels in 0..255.
 vec4 unpack_rgba8(uint v) {
     return vec4(float(v & 0xffu), float((v >> 8) & 0xffu), float((v >> 16) & 0xffu), float(v >> 24));

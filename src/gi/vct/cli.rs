@@ -128,8 +128,8 @@ pub struct VctArgs {
     #[arg(long, value_enum, default_value_t)]
     pub directional_filter: DirectionalFilter,
     /// Keep each cell's surface plane, and count a plane the snapped cones run beside as
-    /// the same rays from cell to cell (correlated occlusion; the dense grid filtered by
-    /// pairs, with snapped cones)
+    /// the same rays from cell to cell (correlated occlusion; filtered by pairs, with
+    /// snapped cones)
     #[arg(long)]
     pub plane_occlusion: bool,
 }
@@ -317,7 +317,10 @@ impl VctArgs {
         }
         let filter = self.directional_filter;
         let store = match (octree, filter) {
-            (true, DirectionalFilter::Pairs) => Store::Octree { capacities: None },
+            (true, DirectionalFilter::Pairs) => Store::Octree {
+                capacities: None,
+                planes: self.plane_occlusion,
+            },
             // The octree's bricks are filtered from their children's bricks, which keep no
             // rows (BENCHMARKS.md, session 37).
             (true, DirectionalFilter::Rows) => {
@@ -330,12 +333,9 @@ impl VctArgs {
                 planes: self.plane_occlusion,
             },
         };
-        // The planes are the dense grid's, filtered by pairs, and only the snapped cones'
-        // march reads them (cones.glsl, plane_increment).
+        // The planes are filtered by pairs, and only the snapped cones' march reads them
+        // (cones.glsl, plane_increment).
         if self.plane_occlusion {
-            if octree {
-                bail!("--plane-occlusion needs --gi dense: the octree keeps no planes");
-            }
             if filter == DirectionalFilter::Rows {
                 bail!("--plane-occlusion needs --directional-filter pairs: the rows filter keeps no planes");
             }

@@ -266,8 +266,7 @@ impl PipelineBase {
         constants[layout::SPEC_OCTREE_DEPTH as usize] = grid.resolution.ilog2();
         constants[layout::SPEC_SNAPPED_CONES as usize] = u32::from(cones.snapped_cones);
         constants[layout::SPEC_LATTICE_CONES as usize] = cones.lattice_cones;
-        constants[layout::SPEC_PLANE_OCCLUSION as usize] =
-            u32::from(matches!(store, Store::Dense { planes: true, .. }));
+        constants[layout::SPEC_PLANE_OCCLUSION as usize] = u32::from(store.planes());
         Self {
             sets: [set_layouts[0], set_layouts[1], set_layouts[2], store_set],
             constants,

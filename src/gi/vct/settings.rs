@@ -5,6 +5,7 @@ use anyhow::{bail, Result};
 use super::octree::Capacities;
 use super::voxelize::Voxelizer;
 use super::Grid;
+use crate::gpu_layout as layout;
 use crate::scene::Scene;
 use crate::vk::Context;
 
@@ -23,7 +24,30 @@ pub enum Store {
     Octree {
         /// Pool sizes to start from instead of the estimate from the scene.
         capacities: Option<Capacities>,
+        /// Whether the interior bricks keep each cell's surface plane, as the dense grid's
+        /// `planes`.
+        planes: bool,
     },
+}
+
+impl Store {
+    /// Whether the store keeps each cell's surface plane (`--plane-occlusion`).
+    pub fn planes(self) -> bool {
+        match self {
+            Self::Dense { planes, .. } | Self::Octree { planes, .. } => planes,
+        }
+    }
+
+    /// The volumes of its directional levels, side by side along x
+    /// (`layout::DIRECTIONAL_SLOTS`).
+    pub fn directional_slots(self) -> u32 {
+        layout::DIRECTIONAL_SLOTS
+            + if self.planes() {
+                layout::PLANE_SLOTS
+            } else {
+                0
+            }
+    }
 }
 
 /// How each directional level's cells are filtered from the voxels below them

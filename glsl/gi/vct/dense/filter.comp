@@ -25,7 +25,7 @@ vec4 load(ivec3 child, int d, int child_edge) {
     return imageLoad(src, child + ivec3((4 * d + 1) * child_edge / 2, 0, 0));
 }
 
-// The cell's surface plane and coverage (DENSE_PLANE_SLOT, DENSE_COVERAGE_SLOT): the
+// The cell's surface plane and coverage (PLANE_SLOT, COVERAGE_SLOT): the
 // mean over its eight children, from the base voxels' opacity, normal and centre at the
 // first level. Premultiplied by opacity, so that a plane read between cells, or between
 // levels, is the same plane whatever the blend: plane.xyz / |plane.xyz| its normal and
@@ -43,8 +43,8 @@ void filter_plane(ivec3 first, int edge, out vec4 plane, out float coverage) {
             plane += a * vec4(normal, dot(normal, centre));
             coverage += a;
         } else {
-            plane += imageLoad(src, child + ivec3((4 * int(DENSE_PLANE_SLOT) + 1) * edge, 0, 0));
-            coverage += imageLoad(src, child + ivec3((4 * int(DENSE_COVERAGE_SLOT) + 1) * edge, 0, 0)).r;
+            plane += imageLoad(src, child + ivec3((4 * int(PLANE_SLOT) + 1) * edge, 0, 0));
+            coverage += imageLoad(src, child + ivec3((4 * int(COVERAGE_SLOT) + 1) * edge, 0, 0)).r;
         }
     }
     plane *= 0.125;
@@ -81,7 +81,7 @@ void main() {
         vec4 plane;
         float coverage;
         filter_plane(first, edge, plane, coverage);
-        store_slot(parent, edge, int(DENSE_PLANE_SLOT), plane);
-        store_slot(parent, edge, int(DENSE_COVERAGE_SLOT), vec4(coverage, 0.0, 0.0, 0.0));
+        store_slot(parent, edge, int(PLANE_SLOT), plane);
+        store_slot(parent, edge, int(COVERAGE_SLOT), vec4(coverage, 0.0, 0.0, 0.0));
     }
 }

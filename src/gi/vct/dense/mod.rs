@@ -66,8 +66,8 @@ fn dense_keeps_static_sums(scene: &Scene, full_update: bool) -> bool {
 const RADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
 impl Volumes {
-    /// `planes`: the directional texture has the planes' slots (`--plane-occlusion`).
-    fn new(ctx: &Arc<Context>, n: u32, static_copies: bool, planes: bool) -> Result<Self> {
+    /// `slots`: the directional texture's volumes (`Store::directional_slots`).
+    fn new(ctx: &Arc<Context>, n: u32, static_copies: bool, slots: u32) -> Result<Self> {
         // Every volume can be copied out, for the checks against the CPU twins.
         let packed_usage = vk::ImageUsageFlags::STORAGE
             | vk::ImageUsageFlags::TRANSFER_DST
@@ -91,8 +91,6 @@ impl Volumes {
             directional_levels(n),
             radiance_usage,
         );
-        let slots =
-            layout::DENSE_DIRECTIONAL_SLOTS + if planes { layout::DENSE_PLANE_SLOTS } else { 0 };
         directional_desc.extent.width = slots * DIRECTIONAL_SLOT * (n / 2);
         let directional = Image::new(ctx, "voxel radiance directional", directional_desc)?;
         let static_sums = static_copies
@@ -199,7 +197,7 @@ impl VoxelStore for Dense {
             ctx,
             resolution,
             dense_keeps_static_sums(scene, full_update),
-            planes,
+            settings.store.directional_slots(),
         )?;
         let writer = SetWriter::new(ctx, set)
             .storage_image(layout::BINDING_VCT_ALBEDO, volumes.albedo.view)

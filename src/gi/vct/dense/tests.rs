@@ -214,8 +214,8 @@ fn filter_planes_match_cpu() {
         .map(|v| v[3])
         .collect();
     let normals = packed_normals(&renderer);
-    let plane_slot = layout::DENSE_PLANE_SLOT as usize;
-    let coverage_slot = layout::DENSE_COVERAGE_SLOT as usize;
+    let plane_slot = layout::PLANE_SLOT as usize;
+    let coverage_slot = layout::COVERAGE_SLOT as usize;
     let (mut planes, coverage) = reference::filter_planes_base(&opacity, &normals, n);
     let mut coverage: Vec<[f32; 4]> = coverage.iter().map(|&c| [c, 0.0, 0.0, 0.0]).collect();
     let mut worst = 0.0f32;

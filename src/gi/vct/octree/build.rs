@@ -113,7 +113,7 @@ impl Octree {
                         // margin moving meshes need) and build the octree once more.
                         log::info!("octree pools fitted to what they hold: {fit:?}");
                         fitted = true;
-                        self.pools = Pools::new(&self.ctx, fit, self.moving())
+                        self.pools = Pools::new(&self.ctx, fit, self.moving(), self.pools.slots)
                             .context("fitting the octree pools")?;
                         self.pools.write_set(&self.ctx, set, self.linear);
                         continue;
@@ -155,7 +155,7 @@ impl Octree {
                 self.pools.capacities.fragments = grown.fragments;
                 next = 0;
             } else {
-                self.pools = Pools::new(&self.ctx, grown, self.moving())
+                self.pools = Pools::new(&self.ctx, grown, self.moving(), self.pools.slots)
                     .context("growing the octree pools")?;
                 self.pools.write_set(&self.ctx, set, self.linear);
                 // The fragments' GPU times stay; the octree's are taken again.

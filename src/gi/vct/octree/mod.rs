@@ -192,7 +192,7 @@ impl VoxelStore for Octree {
         let depth = grid.resolution.trailing_zeros();
         check_depth(depth)?;
         let capacities = match settings.store {
-            Store::Octree { capacities } => capacities,
+            Store::Octree { capacities, .. } => capacities,
             Store::Dense { .. } => None,
         };
         let full_update = settings.full_update;
@@ -229,7 +229,12 @@ impl VoxelStore for Octree {
             .apply();
         let fragments = Fragments::new(ctx, capacities.fragments)?;
         fragments.write_set(ctx, set);
-        let pools = Pools::new(ctx, capacities, scene.has_moving_meshes() || full_update)?;
+        let pools = Pools::new(
+            ctx,
+            capacities,
+            scene.has_moving_meshes() || full_update,
+            settings.store.directional_slots(),
+        )?;
         pools.write_set(ctx, set, linear);
         Ok(Self {
             grid,

@@ -203,8 +203,10 @@ pub(super) struct Pools {
     pub(super) leaf_direct: Image,
     /// Leaf radiance (`OCTREE_RADIANCE_BRICK`³ each: the voxels and a border).
     pub(super) leaf_radiance: Image,
-    /// Interior bricks' six directional radiances, side by side along x.
+    /// Interior bricks' six directional radiances, and with `--plane-occlusion` their
+    /// planes and coverage, side by side along x (`slots` of them).
     pub(super) directional: Image,
+    pub(super) slots: u32,
     /// The occupied leaf voxels with their bricks (`VoxelListHeader`, then two words each).
     pub(super) voxel_list: Buffer,
     /// Per leaf voxel, its fragments' attribute sums and count (`VOXEL_SUM_WORDS` words).
@@ -265,17 +267,22 @@ pub(super) const BOUNCE_DISPATCH_OFFSET: u64 = UPDATE_HEADS_BYTES;
 
 impl Pools {
     /// `moving`: moving meshes are inserted into the octree every frame; the static
-    /// part is kept aside.
-    pub(super) fn new(ctx: &Arc<Context>, capacities: Capacities, moving: bool) -> Result<Self> {
+    /// part is kept aside. `slots`: the interior bricks' volumes (`DIRECTIONAL_SLOTS`,
+    /// and `PLANE_SLOTS` more with `--plane-occlusion`).
+    pub(super) fn new(
+        ctx: &Arc<Context>,
+        capacities: Capacities,
+        moving: bool,
+        slots: u32,
+    ) -> Result<Self> {
         let max_3d = ctx.properties.limits.max_image_dimension3_d;
         let buffer = |name: &str, bytes: u64, extra| storage_buffer(ctx, name, bytes, extra);
         let nodes = u64::from(capacities.nodes);
         let leaf_side = pool_side(capacities.leaf_bricks);
         let interior_side = pool_side(capacities.interior_bricks);
-        let radiance_edge = interior_side.max(leaf_side) * layout::OCTREE_RADIANCE_BRICK;
+        let radiance_edge = (slots * interior_side).max(leaf_side) * layout::OCTREE_RADIANCE_BRICK;
         ensure!(
-            6 * interior_side * layout::OCTREE_RADIANCE_BRICK <= max_3d
-                && leaf_side * layout::OCTREE_RADIANCE_BRICK <= max_3d,
+            radiance_edge <= max_3d,
             "the octree brick pools ({} leaf, {} interior bricks) exceed the device's 3D image \
              size ({max_3d} texels, {radiance_edge} needed): use a smaller --octree-depth",
             capacities.leaf_bricks,
@@ -302,7 +309,7 @@ impl Pools {
             1,
             usage | vk::ImageUsageFlags::SAMPLED,
         );
-        directional_desc.extent.width = 6 * interior_edge;
+        directional_desc.extent.width = slots * interior_edge;
         // A leaf's first sum sits in bits 8-31 of its child entry.
         ensure!(
             capacities.leaf_voxels <= 1 << 24,
@@ -344,6 +351,7 @@ impl Pools {
                 true,
             )?,
             directional: Image::new(ctx, "octree interior radiance", directional_desc)?,
+            slots,
             voxel_list: buffer(
                 "octree voxel list",
                 std::mem::size_of::<VoxelListHeader>() as u64 + 4 * list_words,

@@ -24,9 +24,22 @@ fn build_and_render(
     capacities: Option<Capacities>,
     frames: usize,
 ) -> (Arc<Context>, Renderer) {
-    let settings = gi_settings(1 << depth, Store::Octree { capacities }, false);
-    render_frames(scene, settings, &vec![0.0; frames])
+    let store = Store::Octree {
+        capacities,
+        planes: false,
+    };
+    render_frames(
+        scene,
+        gi_settings(1 << depth, store, false),
+        &vec![0.0; frames],
+    )
 }
+
+/// The octree without the planes (`--plane-occlusion`), its pools from the estimate.
+const OCTREE: Store = Store::Octree {
+    capacities: None,
+    planes: false,
+};
 
 fn build(scene: Scene, depth: u32, capacities: Option<Capacities>) -> (Arc<Context>, Renderer) {
     build_and_render(scene, depth, capacities, 0)
@@ -309,7 +322,7 @@ fn check_structure(svo: &Octree, d: &Downloaded) -> HashSet<[u32; 3]> {
 fn check_octree(scene: Scene, depth: u32, voxelizer: Voxelizer) {
     let triangles = reference::world_triangles(&scene);
     let solid = reference::world_triangles_where(&scene, |m| m.coverage_texture.is_none());
-    let settings = gi_settings(1 << depth, Store::Octree { capacities: None }, false);
+    let settings = gi_settings(1 << depth, OCTREE, false);
     let settings = with_voxelizer(settings, voxelizer);
     let (ctx, renderer) = render_frames(scene, settings, &[]);
     let svo = octree(&renderer).store();
@@ -561,15 +574,20 @@ fn brick_voxels(
 }
 
 /// Every interior brick equals the CPU filter (`gi::reference`) of the level below as
-/// downloaded, the leaves' radiance seen through their normals' facing weights; and
-/// every brick's border holds the voxels of the neighbouring bricks (zero where the
-/// octree is empty, the edge voxel repeated at the grid's edge).
+/// downloaded, the leaves' radiance seen through their normals' facing weights, and with
+/// `--plane-occlusion` its planes and coverage equal the dense grid's CPU twin's; every
+/// brick's border holds the voxels of the neighbouring bricks (zero where the octree is
+/// empty, the edge voxel repeated at the grid's edge), in every slot.
 #[test]
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn bricks_filter_and_borders_match_cpu() {
     let scene = cornell_point();
     let depth = 6;
-    let (ctx, renderer) = build_and_render(scene, depth, None, 1);
+    let store = Store::Octree {
+        capacities: None,
+        planes: true,
+    };
+    let (ctx, renderer) = render_frames(scene, gi_settings(1 << depth, store, false), &[0.0]);
     let svo = octree(&renderer).store();
     let d = download(svo);
     let p = &svo.pools;
@@ -583,9 +601,16 @@ fn bricks_filter_and_borders_match_cpu() {
     let normals = svo.download_leaf_attribute(1).unwrap();
     let attribute_edge = p.leaf_side * layout::OCTREE_ATTRIBUTE_BRICK;
 
-    // Level l's voxels as a dense grid of 2^(l+1) per axis (direction `dir` above the
-    // leaves; the leaves seen along it through their facing weights with `facing`), from
-    // the bricks; zero where there is no brick.
+    // The packed normal of voxel k of leaf brick `brick`.
+    let normal_word = |brick: u32, k: [u32; 3]| {
+        let side = p.leaf_side;
+        let a = [brick % side, (brick / side) % side, brick / (side * side)];
+        let nt: [u32; 3] = std::array::from_fn(|i| a[i] * layout::OCTREE_ATTRIBUTE_BRICK + k[i]);
+        normals[(nt[0] + attribute_edge * (nt[1] + attribute_edge * nt[2])) as usize]
+    };
+    // Level l's voxels as a dense grid of 2^(l+1) per axis (slot `dir` above the leaves;
+    // the leaves seen along it through their facing weights with `facing`), from the
+    // bricks; zero where there is no brick.
     let dense = |level: usize, dir: u32, facing: bool| -> Vec<[f32; 4]> {
         let n = 2u32 << level;
         let mut grid = vec![[0.0f32; 4]; (n as usize).pow(3)];
@@ -595,12 +620,7 @@ fn bricks_filter_and_borders_match_cpu() {
             let value = if is_leaf {
                 let v = leaf.at(brick_texel(brick, p.leaf_side, t, 0));
                 // The filter sees a leaf voxel through its normal's facing weight.
-                let side = p.leaf_side;
-                let a = [brick % side, (brick / side) % side, brick / (side * side)];
-                let nt: [u32; 3] =
-                    std::array::from_fn(|i| a[i] * layout::OCTREE_ATTRIBUTE_BRICK + k[i]);
-                let word =
-                    normals[(nt[0] + attribute_edge * (nt[1] + attribute_edge * nt[2])) as usize];
+                let word = normal_word(brick, k);
                 if facing {
                     reference::seen_facing(word, v, dir as usize)
                 } else {
@@ -646,12 +666,60 @@ fn bricks_filter_and_borders_match_cpu() {
     }
     eprintln!("{checked} interior voxels x directions match the CPU filter, largest difference {worst:.2e}");
 
+    // The planes and coverage: the first interior level from the leaves' opacity and
+    // normals, each level above from the one below as downloaded.
+    let leaves = 1u32 << depth;
+    let mut opacity = vec![0.0f32; (leaves as usize).pow(3)];
+    let mut leaf_normals = vec![0u32; opacity.len()];
+    for (_, brick, c, k) in brick_voxels(&d, depth as usize - 1) {
+        let g: [u32; 3] = std::array::from_fn(|i| 2 * c[i] + k[i]);
+        let i = (g[0] + leaves * (g[1] + leaves * g[2])) as usize;
+        opacity[i] = leaf.at(brick_texel(brick, p.leaf_side, k.map(|x| x as i32), 0))[3];
+        leaf_normals[i] = normal_word(brick, k);
+    }
+    let (mut planes, coverage) = reference::filter_planes_base(&opacity, &leaf_normals, leaves);
+    let mut coverage: Vec<[f32; 4]> = coverage.iter().map(|&c| [c, 0.0, 0.0, 0.0]).collect();
+    let (mut planar, mut covered) = (0, 0);
+    for level in (0..depth as usize - 1).rev() {
+        let n = 2u32 << level;
+        let gpu_planes = dense(level, layout::PLANE_SLOT, false);
+        let gpu_coverage = dense(level, layout::COVERAGE_SLOT, false);
+        for (node, _, c, k) in brick_voxels(&d, level) {
+            let g: [u32; 3] = std::array::from_fn(|i| 2 * c[i] + k[i]);
+            let i = (g[0] + n * (g[1] + n * g[2])) as usize;
+            for (what, got, expected) in [
+                ("plane", gpu_planes[i], planes[i]),
+                ("coverage", gpu_coverage[i], coverage[i]),
+            ] {
+                for (x, y) in got.iter().zip(&expected) {
+                    worst = worst.max((x - y).abs());
+                }
+                assert!(
+                    close(got, expected),
+                    "level {level} node {node} voxel {k:?} {what}: GPU {got:?}, CPU {expected:?}"
+                );
+            }
+            let [x, y, z, _] = gpu_planes[i];
+            if gpu_coverage[i][0] > 0.05 {
+                covered += 1;
+                planar += usize::from((x * x + y * y + z * z).sqrt() >= 0.9 * gpu_coverage[i][0]);
+            }
+        }
+        planes = reference::filter_mean(&gpu_planes, n);
+        coverage = reference::filter_mean(&gpu_coverage, n);
+    }
+    eprintln!(
+        "the planes match the CPU filter too (largest difference so far {worst:.2e}); \
+         {planar} of {covered} covered cells planar"
+    );
+    assert!(2 * planar > covered, "{planar} of {covered} cells planar");
+
     // Borders, at every level: the voxel of the dense grid there, clamped to the grid.
     let mut borders = 0;
     for level in 0..depth as usize {
         let is_leaf = level + 1 == depth as usize;
         let n = 2i32 << level;
-        for dir in 0..if is_leaf { 1 } else { 6 } {
+        for dir in 0..if is_leaf { 1 } else { p.slots } {
             let grid = dense(level, dir, false);
             for &node in &d.levels[level] {
                 let brick = d.bricks[node as usize];
@@ -751,7 +819,7 @@ fn moving_mesh_leaves_no_nodes_behind() {
 }
 
 fn check_moving_mesh(scene: Scene, voxelizer: Voxelizer) {
-    let structure = Store::Octree { capacities: None };
+    let structure = OCTREE;
     let settings = |full_update| with_voxelizer(gi_settings(64, structure, full_update), voxelizer);
     let (ctx, moved) = render_frames(scene.clone(), settings(false), &[0.0, 0.5, 1.0]);
     let (_, fresh) = render_frames(scene.clone(), settings(false), &[1.0]);
@@ -869,7 +937,7 @@ fn shading_what_moving_meshes_change_misses_nothing() {
     });
     let times = [0.0, 0.3, 0.6, 0.9, 1.2, 1.5];
     for shadow_cones in [false, true] {
-        let mut settings = gi_settings(64, Store::Octree { capacities: None }, false);
+        let mut settings = gi_settings(64, OCTREE, false);
         cone_settings(&mut settings).shadow_cones = shadow_cones;
         let run = |every: bool| {
             render_frames_with(scene.clone(), settings.clone(), &times, |r, _| {
@@ -905,7 +973,7 @@ fn shading_what_moving_meshes_change_misses_nothing() {
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn full_update_rebuilds_the_same_octree() {
     let scene = cornell_point();
-    let structure = Store::Octree { capacities: None };
+    let structure = OCTREE;
     let (ctx, full) = render_frames(scene.clone(), gi_settings(64, structure, true), &[0.0, 0.5]);
     let (_, kept) = render_frames(scene, gi_settings(64, structure, false), &[0.0, 0.5]);
     let (full, kept) = (leaf_snapshot(&full), leaf_snapshot(&kept));
@@ -924,7 +992,7 @@ fn carried_light_converges_to_all_bounces() {
     let cornell = shared_file("scenes/cornell_box/CornellBox-Original.obj");
     let dir = std::env::temp_dir().join(format!("voxcone-svo-carry-{}", std::process::id()));
     let scene = moving_cube_scene(&cornell, &dir, false);
-    let settings = gi_settings(64, Store::Octree { capacities: None }, false);
+    let settings = gi_settings(64, OCTREE, false);
     let (ctx, carried) = render_frames(scene.clone(), settings.clone(), &[1.0; 9]);
     let (_, once) = render_frames(scene, settings, &[1.0]);
     // Total leaf radiance (the bounces add light; direct light is the same in both).
@@ -985,7 +1053,7 @@ fn check_update_lists_sliced(
     what: &str,
     slices: u32,
 ) {
-    let mut settings = gi_settings(64, Store::Octree { capacities: None }, false);
+    let mut settings = gi_settings(64, OCTREE, false);
     cone_settings(&mut settings).cones.bounces = bounces;
     let what = format!("{what}, {slices} workgroups a node");
     let (ctx, renderer) = render_frames_with(scene, settings, times, |r, i| {
@@ -1070,7 +1138,7 @@ fn update_lists_follow_moving_meshes() {
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn bounces_stop_once_converged() {
     let scene = cornell_point();
-    let settings = gi_settings(64, Store::Octree { capacities: None }, false);
+    let settings = gi_settings(64, OCTREE, false);
     let frames = 40;
     let mut dispatched = Vec::new();
     let (ctx, renderer) = render_frames_with(scene, settings, &vec![0.0; frames], |r, i| {

@@ -37,7 +37,7 @@ void main() {
             vec4 value = brick == OCTREE_NO_BRICK ? vec4(0.0) : imageLoad(leaf_radiance, from);
             imageStore(leaf_radiance, origin + t, value);
         } else {
-            for (int d = 0; d < 6; d++) {
+            for (int d = 0; d < int(directional_slots()); d++) {
                 ivec3 shift = ivec3(d * direction_stride, 0, 0);
                 vec4 value = brick == OCTREE_NO_BRICK ? vec4(0.0) : imageLoad(directional, from + shift);
                 imageStore(directional, origin + t + shift, value);

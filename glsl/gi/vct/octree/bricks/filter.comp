@@ -3,13 +3,40 @@
 // voxel o of a node is its child o filtered to one voxel along each of the six
 // directions (gi/vct/anisotropic.glsl), from the child's brick: the leaves' isotropic
 // radiance seen through their normals' facing weight, or an interior child's directional
-// radiance. Empty children count as empty space.
+// radiance. Empty children count as empty space. With `--plane-occlusion` the two slots
+// after the six directions get the child's surface plane and coverage, as the dense
+// grid's filter computes them (dense/filter.comp, filter_plane).
 #include "gi/vct/octree/nodes/level.glsl"
 #include "gi/vct/anisotropic.glsl"
 
 layout(set = SET_GI, binding = BINDING_VCT_NORMAL, r32ui) uniform readonly uimage3D leaf_normal;
 layout(set = SET_GI, binding = BINDING_VCT_RADIANCE, rgba16f) uniform readonly image3D leaf_radiance;
 layout(set = SET_GI, binding = BINDING_OCTREE_DIRECTIONAL_STORAGE, rgba16f) uniform image3D directional;
+
+// Child o's plane and coverage (PLANE_SLOT, COVERAGE_SLOT): the mean over its eight
+// voxels, from the leaves' opacity, normal and centre where the children are leaves.
+// `child` is the child's node coordinates at the level below.
+void filter_plane(bool leaf_children, ivec3 radiance_origin, ivec3 normal_origin, ivec3 child,
+                  int direction_stride, out vec4 plane, out float coverage) {
+    plane = vec4(0.0);
+    coverage = 0.0;
+    float n = float(vct.resolution);
+    for (int i = 0; i < 8; i++) {
+        ivec3 k = ivec3(i & 1, (i >> 1) & 1, i >> 2);
+        if (leaf_children) {
+            float a = imageLoad(leaf_radiance, radiance_origin + k).a;
+            vec3 normal = unit_voxel_normal(imageLoad(leaf_normal, normal_origin + k).r);
+            vec3 centre = (vec3(child * 2 + k) + 0.5) / n - 0.5;
+            plane += a * vec4(normal, dot(normal, centre));
+            coverage += a;
+        } else {
+            plane += imageLoad(directional, radiance_origin + k + ivec3(int(PLANE_SLOT) * direction_stride, 0, 0));
+            coverage += imageLoad(directional, radiance_origin + k + ivec3(int(COVERAGE_SLOT) * direction_stride, 0, 0)).r;
+        }
+    }
+    plane *= 0.125;
+    coverage *= 0.125;
+}
 
 void main() {
     uint node;
@@ -25,7 +52,7 @@ void main() {
         ivec3 voxel = ivec3(o & 1, (o >> 1) & 1, o >> 2);
         uint brick = node_bricks[tile + uint(o)];
         if (brick == OCTREE_NO_BRICK) {
-            for (int d = 0; d < 6; d++) {
+            for (int d = 0; d < int(directional_slots()); d++) {
                 imageStore(directional, out_origin + voxel + ivec3(d * direction_stride, 0, 0), vec4(0.0));
             }
             continue;
@@ -43,6 +70,15 @@ void main() {
                 }
             }
             imageStore(directional, out_origin + voxel + ivec3(d * direction_stride, 0, 0), filter_children(children, d));
+        }
+        if (PLANE_OCCLUSION) {
+            ivec3 child = ivec3(unpack_coord(node_coords[node])) * 2 + voxel;
+            vec4 plane;
+            float coverage;
+            filter_plane(leaf_children, radiance_origin, normal_origin, child, direction_stride, plane, coverage);
+            imageStore(directional, out_origin + voxel + ivec3(int(PLANE_SLOT) * direction_stride, 0, 0), plane);
+            imageStore(directional, out_origin + voxel + ivec3(int(COVERAGE_SLOT) * direction_stride, 0, 0),
+                       vec4(coverage, 0.0, 0.0, 0.0));
         }
     }
 }
