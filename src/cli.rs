@@ -954,35 +954,20 @@ mod tests {
     }
 
     #[test]
-    fn plane_occlusion_needs_pairs_and_snapped_cones() {
-        let parse = |args: &[&str]| render(args, &GiOverrides::default());
-        let gi = cone_tracing(parse(&["voxcone", "render", "--plane-occlusion"]).unwrap());
-        assert_eq!(
-            gi.store,
-            Store::Dense {
-                filter: DirectionalFilter::Pairs,
-                planes: true,
-            }
-        );
-        let octree = ["voxcone", "render", "--plane-occlusion", "--gi", "octree"];
-        assert_eq!(
-            cone_tracing(parse(&octree).unwrap()).store,
-            Store::Octree {
-                capacities: None,
-                planes: true,
-            }
-        );
-        for (extra, cause) in [
-            (
-                &["--directional-filter", "rows"][..],
-                "needs --directional-filter pairs",
-            ),
-            (&["--quality", "fast"][..], "needs snapped cones"),
-        ] {
-            let args = [&["voxcone", "render", "--plane-occlusion"][..], extra].concat();
-            let error = parse(&args).unwrap_err().to_string();
-            assert!(error.contains(cause), "{extra:?}: {error}");
-        }
+    fn planes_wherever_pairs_and_snapped_cones_meet() {
+        let planes = |args: &[&str]| {
+            let args = [&["voxcone", "render"][..], args].concat();
+            cone_tracing(render(&args, &GiOverrides::default()).unwrap())
+                .store
+                .planes()
+        };
+        assert!(planes(&[]));
+        assert!(planes(&["--gi", "octree"]));
+        assert!(planes(&["--quality", "fast", "--snapped-cones"]));
+        assert!(!planes(&["--no-plane-occlusion"]));
+        assert!(!planes(&["--gi", "octree", "--no-plane-occlusion"]));
+        assert!(!planes(&["--directional-filter", "rows"]));
+        assert!(!planes(&["--quality", "fast"]));
     }
 
     #[test]

@@ -488,7 +488,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                     ..
                 }
             );
-            let mut planes = vct.store.planes();
+            let mut planes = !args.no_plane_occlusion;
             settle(ui.add_enabled(
                 !snapped_now,
                 egui::Checkbox::new(&mut wide, "wide steps by level"),
@@ -511,8 +511,8 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                      averaged (the dense grid only); off: children in pairs",
                 ),
             );
-            // The planes need the filter by pairs and snapped cones: cleared with them,
-            // so that the panel is never left with a refusal.
+            // The planes apply only with the filter by pairs and snapped cones: elsewhere
+            // the box is greyed out and keeps its choice for when they apply again.
             let planes_possible = !rows && (snapped || lattice);
             settle(
                 ui.add_enabled(
@@ -545,7 +545,9 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
             } else {
                 DirectionalFilter::Pairs
             };
-            args.plane_occlusion = planes && planes_possible;
+            if planes_possible {
+                args.no_plane_occlusion = !planes;
+            }
             if voxelizer != vct.voxelizer {
                 args.voxelizer = voxelizer;
             }

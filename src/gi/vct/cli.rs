@@ -127,11 +127,12 @@ pub struct VctArgs {
     /// How the dense grid's directional levels are filtered from the voxels
     #[arg(long, value_enum, default_value_t)]
     pub directional_filter: DirectionalFilter,
-    /// Keep each cell's surface plane, and count a plane the snapped cones run beside as
-    /// the same rays from cell to cell (correlated occlusion; filtered by pairs, with
-    /// snapped cones)
+    /// Composite every cell's opacity as uncorrelated with the cells before it. By default,
+    /// where the cones are snapped (the lattice, --snapped-cones) and the directional
+    /// levels filtered by pairs, each cell keeps its surface plane and a cone counts a
+    /// plane it runs beside as the same rays from cell to cell (correlated occlusion)
     #[arg(long)]
-    pub plane_occlusion: bool,
+    pub no_plane_occlusion: bool,
 }
 
 impl VctArgs {
@@ -164,7 +165,7 @@ impl VctArgs {
                 "--directional-filter",
             ),
             (self.sampled_emitters.is_some(), "--sampled-emitters"),
-            (self.plane_occlusion, "--plane-occlusion"),
+            (self.no_plane_occlusion, "--no-plane-occlusion"),
         ]
         .into_iter()
         .filter_map(|(set, flag)| set.then_some(flag))
@@ -316,10 +317,14 @@ impl VctArgs {
             check_voxel_size(size)?;
         }
         let filter = self.directional_filter;
+        // The planes are filtered by pairs, and only the snapped cones' march reads them
+        // (cones.glsl, plane_increment).
+        let planes =
+            !self.no_plane_occlusion && filter == DirectionalFilter::Pairs && cones.snapped_cones;
         let store = match (octree, filter) {
             (true, DirectionalFilter::Pairs) => Store::Octree {
                 capacities: None,
-                planes: self.plane_occlusion,
+                planes,
             },
             // The octree's bricks are filtered from their children's bricks, which keep no
             // rows (BENCHMARKS.md, session 37).
@@ -328,21 +333,8 @@ impl VctArgs {
                     "--directional-filter rows needs --gi dense: the octree filters by pairs only"
                 )
             }
-            (false, filter) => Store::Dense {
-                filter,
-                planes: self.plane_occlusion,
-            },
+            (false, filter) => Store::Dense { filter, planes },
         };
-        // The planes are filtered by pairs, and only the snapped cones' march reads them
-        // (cones.glsl, plane_increment).
-        if self.plane_occlusion {
-            if filter == DirectionalFilter::Rows {
-                bail!("--plane-occlusion needs --directional-filter pairs: the rows filter keeps no planes");
-            }
-            if !cones.snapped_cones {
-                bail!("--plane-occlusion needs snapped cones (--snapped-cones or --lattice-cones): only their march reads the planes");
-            }
-        }
         let voxels = match (octree, self.octree_depth, voxels) {
             (true, Some(depth), _) => {
                 check_depth(depth)?;
