@@ -17,8 +17,8 @@ use crate::gpu_layout::{self as layout, OctreeBounceDispatch, OctreeCounters, Oc
 use crate::progress::Progress;
 use crate::scene_gpu::SceneDraw;
 use crate::vk::{
-    compute_to_compute, copies_to_host_barrier, image_barrier, stage_barrier, update_buffer,
-    Buffer, GpuTimer, OneShot,
+    clear_to_zero, compute_to_compute, copies_to_host_barrier, image_barrier, stage_barrier,
+    update_buffer, Buffer, GpuTimer, ImageUse, OneShot,
 };
 
 /// What a build made, measured: the counters, the level table and GPU time per pass.
@@ -433,17 +433,35 @@ impl Octree {
 
         timer.begin(cmd, "brick fill");
         if build {
-            // No clears of the pools, only their layouts (clears cost 65 ms of the
-            // depth-10 Sponza build on an H200): the list pass writes every attribute
-            // texel of the bricks in use and zeroes the radiance bricks it gives out, the
-            // direct light is read only at listed voxels, and the filter and the borders
-            // write every texel of the interior bricks in use.
+            // No clears of the pools at every build, only their layouts (clears cost
+            // 65 ms of the depth-10 Sponza build on an H200): the list pass writes every
+            // attribute texel of the bricks in use and zeroes the radiance bricks it gives
+            // out, the direct light is read only at listed voxels, and the filter and the
+            // borders write every texel of the interior bricks in use. But the sampler
+            // fetches the texel beyond a brick's border too, weighted 0, where the
+            // lookup lands on the border's centre, and 0 times a NaN left in new memory
+            // (an earlier image's packed words) is a NaN: the sampled images are zeroed
+            // once, when made.
             let attributes = p.leaf_attributes.iter().map(|image| (image, BRICK_USE));
-            let radiance = [&p.leaf_radiance, &p.leaf_direct, &p.directional]
+            let radiance = [&p.leaf_direct]
                 .into_iter()
                 .map(|image| (image, RADIANCE_USE));
             for (image, to) in attributes.chain(radiance) {
                 image_barrier(ctx, cmd, image.raw, image.full_range(), p.last_use(), to);
+            }
+            for image in [&p.leaf_radiance, &p.directional] {
+                if p.in_general.get() {
+                    image_barrier(
+                        ctx,
+                        cmd,
+                        image.raw,
+                        image.full_range(),
+                        p.last_use(),
+                        RADIANCE_USE,
+                    );
+                } else {
+                    clear_to_zero(ctx, cmd, image, ImageUse::UNDEFINED, RADIANCE_USE);
+                }
             }
             p.in_general.set(true);
         }

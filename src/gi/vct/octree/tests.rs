@@ -598,6 +598,17 @@ fn bricks_filter_and_borders_match_cpu() {
     };
     let leaf = read(&p.leaf_radiance);
     let interior = read(&p.directional);
+    // Every texel is finite, those of the bricks not in use too: the sampler fetches
+    // beyond a brick's border, weighted 0, and 0 times a NaN is a NaN.
+    for (name, pool) in [("leaf radiance", &leaf), ("interior bricks", &interior)] {
+        let bad = pool
+            .texels
+            .iter()
+            .flatten()
+            .filter(|v| !v.is_finite())
+            .count();
+        assert_eq!(bad, 0, "{name}: {bad} values not finite");
+    }
     let normals = svo.download_leaf_attribute(1).unwrap();
     let attribute_edge = p.leaf_side * layout::OCTREE_ATTRIBUTE_BRICK;
 
