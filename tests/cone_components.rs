@@ -205,6 +205,20 @@ fn furnace_within_two_percent_at_every_resolution_with(name: &str, extra: &[&str
     }
 }
 
+/// The furnace of `probe_furnace` in `dir`, with two black specks beyond its corners
+/// (`speck.obj`) that stretch the scene's bounds and so put its walls inside the grid.
+fn furnace_with_specks(dir: &Path) {
+    probe_furnace(dir);
+    write(dir, "speck.mtl", "newmtl black\nKd 0 0 0\n");
+    write(
+        dir,
+        "speck.obj",
+        "mtllib speck.mtl\nusemtl black\n\
+         v -1.3 -1.3 -1.3\nv -1.299 -1.3 -1.3\nv -1.3 -1.299 -1.3\n\
+         v 1.3 1.3 1.3\nv 1.299 1.3 1.3\nv 1.3 1.299 1.3\nf 1 2 3\nf 4 5 6\n",
+    );
+}
+
 /// The furnace of `furnace_within_two_percent_at_every_resolution` with two black specks
 /// beyond its corners, which stretch the scene's bounds: its walls lie inside the grid,
 /// not on its faces, as a room's ceiling does in the cube around a wide scene
@@ -215,15 +229,7 @@ fn furnace_within_two_percent_at_every_resolution_with(name: &str, extra: &[&str
 /// let nothing through. Returns that share at each of `voxels`.
 fn furnace_inside_the_grid(name: &str, extra: &[&str], voxels: &[u32]) -> Vec<f32> {
     let dir = temp_dir(name);
-    probe_furnace(&dir);
-    write(&dir, "speck.mtl", "newmtl black\nKd 0 0 0\n");
-    write(
-        &dir,
-        "speck.obj",
-        "mtllib speck.mtl\nusemtl black\n\
-         v -1.3 -1.3 -1.3\nv -1.299 -1.3 -1.3\nv -1.3 -1.299 -1.3\n\
-         v 1.3 1.3 1.3\nv 1.299 1.3 1.3\nv 1.3 1.299 1.3\nf 1 2 3\nf 4 5 6\n",
-    );
+    furnace_with_specks(&dir);
     let scene = write(
         &dir,
         "inside.toml",
@@ -296,19 +302,11 @@ fn furnace_inside_the_grid_within_two_percent() {
 #[ignore = "issue 20: 0.957 of the walls' radiance in the median pixel at 64³ (0.969 without the planes)"]
 fn walls_of_a_closed_room_inside_the_grid_gather_its_radiance() {
     let dir = temp_dir("components_room_walls");
-    probe_furnace(&dir);
+    furnace_with_specks(&dir);
     write(
         &dir,
         "box.mtl",
         "newmtl wall\nKd 1 1 1\nKe 0.5 0.5 0.5\nnewmtl probe\nKd 1 1 1\n",
-    );
-    write(&dir, "speck.mtl", "newmtl black\nKd 0 0 0\n");
-    write(
-        &dir,
-        "speck.obj",
-        "mtllib speck.mtl\nusemtl black\n\
-         v -1.3 -1.3 -1.3\nv -1.299 -1.3 -1.3\nv -1.3 -1.299 -1.3\n\
-         v 1.3 1.3 1.3\nv 1.299 1.3 1.3\nv 1.3 1.299 1.3\nf 1 2 3\nf 4 5 6\n",
     );
     let scene = write(
         &dir,
