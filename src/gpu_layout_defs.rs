@@ -148,9 +148,9 @@ gpu_layout! {
         BINDING_FILTER_ROWS_DST = 5;
         /// Workgroup edge of the 3D compute passes.
         VOXEL_GROUP_SIZE = 4;
-        /// Slots of the directional volumes (the dense grid's texture, the octree's interior bricks), side by side along x: the six directions +X -X +Y -Y +Z -Z, and with `--plane-occlusion` two more, the cells' surface planes (`PLANE_SLOT`) and coverage (`COVERAGE_SLOT`).
+        /// Slots of the directional volumes (the dense grid's texture, the octree's interior bricks), side by side along x: the six directions +X -X +Y -Y +Z -Z, and with the planes (`Store::planes`) two more, the cells' surface planes (`PLANE_SLOT`) and coverage (`COVERAGE_SLOT`).
         DIRECTIONAL_SLOTS = 6;
-        /// The slots `--plane-occlusion` adds to the directional volumes.
+        /// The slots the planes (`Store::planes`) add to the directional volumes.
         PLANE_SLOTS = 2;
         /// Slot of the directional volumes holding each cell's surface plane, premultiplied by coverage: xyz the mean of its voxels' opacity times normal, w the mean of opacity times the plane constant dot(normal, position) (position in grid units, 0..1 across the grid, less 0.5).
         PLANE_SLOT = 6;
@@ -218,7 +218,7 @@ gpu_layout! {
         SPEC_SNAPPED_CONES = 1;
         /// Specialization constant id, given to every pipeline of voxel cone tracing: the cones of the screen's diffuse gather's lattice (`--lattice-cones`), spread evenly over the cosine-weighted hemisphere; 0 for the ring of `diffuse_cones`. A constant for the reason `SPEC_SNAPPED_CONES` is one; the ring's gather also ran 0.5 % slower on lavapipe with the lattice's branch on a uniform.
         SPEC_LATTICE_CONES = 2;
-        /// Specialization constant id, given to every pipeline of voxel cone tracing: 1 where the voxel store (the dense grid or the octree) keeps each cell's surface plane and the snapped cones count a plane they run beside as the same rays from cell to cell (`--plane-occlusion`, `PLANE_SLOT`); 0 where every cell's opacity is composited as uncorrelated. A constant for the reason `SPEC_SNAPPED_CONES` is one.
+        /// Specialization constant id, given to every pipeline of voxel cone tracing: 1 where the voxel store (the dense grid or the octree) keeps each cell's surface plane and the snapped cones count a plane they run beside as the same rays from cell to cell (`Store::planes`, `PLANE_SLOT`); 0 where every cell's opacity is composited as uncorrelated. A constant for the reason `SPEC_SNAPPED_CONES` is one.
         SPEC_PLANE_OCCLUSION = 3;
         /// Specialization constant id of the shadow pass: 1 where cut-outs cast whole shadows whatever their coverage (`RenderSettings::opaque_shadow_cut_outs`, the references' convention), 0 where they cast none where cut.
         SPEC_SHADOW_OPAQUE_CUT_OUTS = 0;
@@ -880,7 +880,7 @@ gpu_layout! {
     struct FilterPush {
         /// The directional level written: 0 is the first above the base, each cell 2 << level voxels wide.
         uint level,
-        /// 1: also the cells' surface planes and coverage (`--plane-occlusion`, `PLANE_SLOT`).
+        /// 1: also the cells' surface planes and coverage (`Store::planes`, `PLANE_SLOT`).
         uint planes,
     }
 

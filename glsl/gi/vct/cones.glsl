@@ -132,11 +132,11 @@ int major_axis(vec3 m) {
 // composited behind `acc` for a path of `footprints`; with `ao_volume` (0..5), the
 // ambient occlusion's own opacity from that volume at `uvw`, weighted down with the
 // distance `dist` (trace_cone).
-// With `--plane-occlusion` (march_cells): `limit` (plane_increment: x the most opacity
-// a surface plane allows here, y how planar the cells are) caps the sample's opacity in
-// that proportion, (1, 0) for none; and it is raised to at least `least`, that part with
-// the radiance `beyond` (a plane the cone has crossed, whose rays meet it further on).
-// Returns the opacity composited.
+// With the planes (PLANE_OCCLUSION, march_cells): `limit` (plane_increment: x the most
+// opacity a surface plane allows here, y how planar the cells are) caps the sample's
+// opacity in that proportion, (1, 0) for none; and it is raised to at least `least`, that
+// part with the radiance `beyond` (a plane the cone has crossed, whose rays meet it
+// further on). Returns the opacity composited.
 float composite(vec4 s, float footprints, vec2 limit, float least, vec3 beyond, int ao_volume, vec3 uvw, float lod,
                 float dist, inout vec4 acc, inout float ao, inout float ao_alpha) {
     float own = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), footprints);
@@ -154,7 +154,7 @@ float composite(vec4 s, float footprints, vec2 limit, float least, vec3 beyond, 
     return a;
 }
 
-// A surface plane a snapped cone has met (`--plane-occlusion`, plane_increment): xyz its
+// A surface plane a snapped cone has met (PLANE_OCCLUSION, plane_increment): xyz its
 // normal and w its constant (in grid units less 0.5), the share of the cone's disc
 // counted as blocked by it so far, its radiance as the cone saw it, and whether the
 // cone's axis has crossed it.
@@ -176,7 +176,7 @@ float disc_segment(vec4 plane, vec3 axis, vec3 origin, vec3 dir, float radius) {
     return (acos(u) - u * sqrt(1.0 - u * u)) / 3.14159265;
 }
 
-// Surface planes seen by a snapped cone (`--plane-occlusion`): a plane beside the cone
+// Surface planes seen by a snapped cone (PLANE_OCCLUSION): a plane beside the cone
 // blocks the share of its disc beyond the plane, a circular segment that grows as the
 // disc widens, and it is the same rays in every cell that holds the plane. Composited cell
 // after cell as if uncorrelated, an edge-on floor beside the cone closed it entirely

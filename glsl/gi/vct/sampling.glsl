@@ -45,11 +45,11 @@ void sample_base_snapped(vec3 uvw, out vec4 sx, out vec4 sy, out vec4 sz) {
     sz = textureLod(voxel_radiance, vec3(uvw.xy, cell_centre(uvw.z, cells)), 0.0);
 }
 
-// Where `uvw` of the directional volume d (+X -X +Y -Y +Z -Z, with `--plane-occlusion`
-// then the planes and coverage) lies in their texture. They sit side by side along x,
-// each in the middle of a slot twice its width whose margins repeat its edge voxels
-// (filter.comp), so that filtering clamps at the cube's faces as at the texture's and
-// never mixes two directions, at every level alike.
+// Where `uvw` of the directional volume d (+X -X +Y -Y +Z -Z, with the planes
+// (PLANE_OCCLUSION) then the planes and coverage) lies in their texture. They sit side by
+// side along x, each in the middle of a slot twice its width whose margins repeat its edge
+// voxels (filter.comp), so that filtering clamps at the cube's faces as at the texture's
+// and never mixes two directions, at every level alike.
 vec3 directional_slot(int d, vec3 uvw) {
     return vec3((float(d) + 0.25 + 0.5 * clamp(uvw.x, 0.0, 1.0)) / float(directional_slots()), uvw.yz);
 }
@@ -164,7 +164,7 @@ vec4 read_leaf(BrickSample s) {
 
 // Directional radiance d of an interior brick, trilinear, at a located place. The six
 // directions of a brick sit side by side along x, one pool width apart, and with
-// `--plane-occlusion` the plane and coverage after them (directional_slots).
+// the planes (PLANE_OCCLUSION) the plane and coverage after them (directional_slots).
 vec4 read_interior(BrickSample s, int d) {
     float edge = float(counters.interior_pool_side * OCTREE_RADIANCE_BRICK);
     vec3 texel = vec3(brick_origin(s.brick, counters.interior_pool_side, OCTREE_RADIANCE_BRICK)) + 1.0 + s.local;

@@ -9,8 +9,9 @@ layout(set = SET_GI, binding = BINDING_VCT_UNIFORMS) uniform VctBlock {
     VctUniforms vct;
 };
 
-// `--plane-occlusion` (cones.glsl, plane_increment; PLANE_SLOT of the directional
-// volumes), fixed when the pipeline is made, for the reason SNAPPED_CONES is.
+// Whether the cells keep their surface planes (cones.glsl, plane_increment; PLANE_SLOT of
+// the directional volumes; `--no-plane-occlusion`), fixed when the pipeline is made, for
+// the reason SNAPPED_CONES is.
 layout(constant_id = SPEC_PLANE_OCCLUSION) const bool PLANE_OCCLUSION = false;
 
 // Slots of the directional volumes side by side along x (DIRECTIONAL_SLOTS).

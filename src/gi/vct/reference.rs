@@ -126,7 +126,7 @@ fn unpacked_normal(packed: u32) -> Vec3 {
     }
 }
 
-/// The first level of the cells' surface planes and coverage (`--plane-occlusion`) from
+/// The first level of the cells' surface planes and coverage (`Store::planes`) from
 /// the base level's opacity and packed normals (resolution n): per cell of 2x2x2 voxels,
 /// the mean of opacity times (normal, normal . centre), the centre in grid units less 0.5,
 /// and the mean opacity.

@@ -17,7 +17,8 @@ pub enum Store {
         /// How its directional levels are filtered.
         filter: DirectionalFilter,
         /// Whether the filter keeps each cell's surface plane, which the snapped cones
-        /// count as the same rays from cell to cell (`--plane-occlusion`).
+        /// count as the same rays from cell to cell (the default where the cones are
+        /// snapped; `--no-plane-occlusion`).
         planes: bool,
     },
     /// A sparse voxel octree of the same effective resolution (`--gi octree`).
@@ -31,7 +32,8 @@ pub enum Store {
 }
 
 impl Store {
-    /// Whether the store keeps each cell's surface plane (`--plane-occlusion`).
+    /// Whether the store keeps each cell's surface plane (the default where the cones are
+    /// snapped; `--no-plane-occlusion`).
     pub fn planes(self) -> bool {
         match self {
             Self::Dense { planes, .. } | Self::Octree { planes, .. } => planes,

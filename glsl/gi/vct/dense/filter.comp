@@ -2,8 +2,8 @@
 // One level of the dense grid's anisotropic mip chain (gi/vct/anisotropic.glsl). The
 // first level reads the isotropic base; the six directions sit side by side along x,
 // direction d's cube of edge `edge` in the middle of a slot 2 * edge wide, starting at
-// x = (2d + 1/2) * edge, and with `--plane-occlusion` the cells' planes and coverage after
-// them. The voxel just outside each x face repeats the face's voxel:
+// x = (2d + 1/2) * edge, and with the planes (PLANE_OCCLUSION) the cells' planes and
+// coverage after them. The voxel just outside each x face repeats the face's voxel:
 // trilinear filtering reads no further (gi/sampling.glsl).
 #include "gpu_layout.glsl"
 #include "gi/vct/anisotropic.glsl"

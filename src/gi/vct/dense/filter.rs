@@ -23,7 +23,7 @@ pub struct FilterPass {
     /// k-1 (by pairs) or the rows of level k-1 (by rows).
     level_sets: Vec<vk::DescriptorSet>,
     by_rows: bool,
-    /// By pairs: also the cells' surface planes (`--plane-occlusion`).
+    /// By pairs: also the cells' surface planes (`Store::planes`).
     planes: bool,
     _sets: DescriptorSets,
     /// Per-level views of the directional texture, referenced by the sets.

@@ -192,7 +192,7 @@ fn filter_matches_cpu() {
     assert_eq!(ctx.validation_messages(), 0);
 }
 
-/// With `--plane-occlusion`, each level of the cells' planes and coverage equals the CPU
+/// With the planes (`Store::planes`), each level of the cells' planes and coverage equals the CPU
 /// filter applied to the level below as downloaded (the first level: the base opacity
 /// and normals), within half-float rounding; and the planes are planes: most covered
 /// cells of the Cornell box (walls, floor, blocks) hold one, |mean opacity x normal| at

@@ -203,7 +203,7 @@ pub(super) struct Pools {
     pub(super) leaf_direct: Image,
     /// Leaf radiance (`OCTREE_RADIANCE_BRICK`³ each: the voxels and a border).
     pub(super) leaf_radiance: Image,
-    /// Interior bricks' six directional radiances, and with `--plane-occlusion` their
+    /// Interior bricks' six directional radiances, and with the planes (`Store::planes`) their
     /// planes and coverage, side by side along x (`slots` of them).
     pub(super) directional: Image,
     pub(super) slots: u32,
@@ -268,7 +268,7 @@ pub(super) const BOUNCE_DISPATCH_OFFSET: u64 = UPDATE_HEADS_BYTES;
 impl Pools {
     /// `moving`: moving meshes are inserted into the octree every frame; the static
     /// part is kept aside. `slots`: the interior bricks' volumes (`DIRECTIONAL_SLOTS`,
-    /// and `PLANE_SLOTS` more with `--plane-occlusion`).
+    /// and `PLANE_SLOTS` more with the planes: `Store::planes`).
     pub(super) fn new(
         ctx: &Arc<Context>,
         capacities: Capacities,

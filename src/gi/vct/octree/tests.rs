@@ -35,7 +35,7 @@ fn build_and_render(
     )
 }
 
-/// The octree without the planes (`--plane-occlusion`), its pools from the estimate.
+/// The octree without the planes (`Store::planes`), its pools from the estimate.
 const OCTREE: Store = Store::Octree {
     capacities: None,
     planes: false,
@@ -575,7 +575,7 @@ fn brick_voxels(
 
 /// Every interior brick equals the CPU filter (`gi::reference`) of the level below as
 /// downloaded, the leaves' radiance seen through their normals' facing weights, and with
-/// `--plane-occlusion` its planes and coverage equal the dense grid's CPU twin's; every
+/// the planes (`Store::planes`) its planes and coverage equal the dense grid's CPU twin's; every
 /// brick's border holds the voxels of the neighbouring bricks (zero where the octree is
 /// empty, the edge voxel repeated at the grid's edge), in every slot.
 #[test]

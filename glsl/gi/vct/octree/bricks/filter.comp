@@ -3,9 +3,9 @@
 // voxel o of a node is its child o filtered to one voxel along each of the six
 // directions (gi/vct/anisotropic.glsl), from the child's brick: the leaves' isotropic
 // radiance seen through their normals' facing weight, or an interior child's directional
-// radiance. Empty children count as empty space. With `--plane-occlusion` the two slots
-// after the six directions get the child's surface plane and coverage, as the dense
-// grid's filter computes them (dense/filter.comp, filter_plane).
+// radiance. Empty children count as empty space. With the planes (PLANE_OCCLUSION) the
+// two slots after the six directions get the child's surface plane and coverage, as the
+// dense grid's filter computes them (dense/filter.comp, filter_plane).
 #include "gi/vct/octree/nodes/level.glsl"
 #include "gi/vct/anisotropic.glsl"
 
