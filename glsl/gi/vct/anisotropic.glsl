@@ -13,6 +13,14 @@ vec3 unit_voxel_normal(uint packed_normal) {
     return length(n) < 0.2 ? vec3(0.0) : normalize(n);
 }
 
+// A base voxel's surface plane premultiplied by its opacity `a` (PLANE_SLOT): a times
+// (unit normal, normal . centre), the voxel `v` of a grid of `n` per axis, its centre in
+// grid units less 0.5. Both stores' filters sum these over a cell.
+vec4 voxel_plane(float a, uint packed_normal, ivec3 v, float n) {
+    vec3 normal = unit_voxel_normal(packed_normal);
+    return a * vec4(normal, dot(normal, (vec3(v) + 0.5) / n - 0.5));
+}
+
 // Of a base voxel with packed RGBA8 normal `packed_normal`, the part a cone travelling
 // along `d` sees: all of it when the cone looks at the voxel's lit face, half of it
 // edge-on, none from behind. Opacity is weighted too: without this, a cone leaving a

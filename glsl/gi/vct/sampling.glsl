@@ -224,8 +224,9 @@ vec4 sample_directional(int d, vec3 uvw, float level) {
     return mix(near, far, t);
 }
 
-// The surface plane and coverage of the cells at `uvw` and `level` (PLANE_SLOT,
-// octree/bricks/filter.comp), as the dense grid's: the plane premultiplied by coverage.
+// The surface plane and coverage of the cells at `uvw` and whole level `level` (the
+// march's cells; PLANE_SLOT, octree/bricks/filter.comp), as the dense grid's: the plane
+// premultiplied by coverage.
 void sample_plane(vec3 uvw, float level, out vec4 plane, out float coverage) {
     uint fine;
     uint coarse;
@@ -237,16 +238,6 @@ void sample_plane(vec3 uvw, float level, out vec4 plane, out float coverage) {
     if (locate(uvw, fine, s)) {
         plane = read_interior(s, int(PLANE_SLOT));
         coverage = read_interior(s, int(COVERAGE_SLOT)).r;
-    }
-    if (t > 0.0) {
-        vec4 far = vec4(0.0);
-        float far_coverage = 0.0;
-        if (locate(uvw, coarse, s)) {
-            far = read_interior(s, int(PLANE_SLOT));
-            far_coverage = read_interior(s, int(COVERAGE_SLOT)).r;
-        }
-        plane = mix(plane, far, t);
-        coverage = mix(coverage, far_coverage, t);
     }
 }
 

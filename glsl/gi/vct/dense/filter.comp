@@ -38,9 +38,7 @@ void filter_plane(ivec3 first, int edge, out vec4 plane, out float coverage) {
         ivec3 child = first + ivec3(i & 1, (i >> 1) & 1, i >> 2);
         if (push.level == 0u) {
             float a = imageLoad(base_level, child).a;
-            vec3 normal = unit_voxel_normal(imageLoad(voxel_normal, child).r);
-            vec3 centre = (vec3(child) + 0.5) / n - 0.5;
-            plane += a * vec4(normal, dot(normal, centre));
+            plane += voxel_plane(a, imageLoad(voxel_normal, child).r, child, n);
             coverage += a;
         } else {
             plane += imageLoad(src, child + ivec3((4 * int(PLANE_SLOT) + 1) * edge, 0, 0));

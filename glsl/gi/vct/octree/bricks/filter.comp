@@ -25,9 +25,7 @@ void filter_plane(bool leaf_children, ivec3 radiance_origin, ivec3 normal_origin
         ivec3 k = ivec3(i & 1, (i >> 1) & 1, i >> 2);
         if (leaf_children) {
             float a = imageLoad(leaf_radiance, radiance_origin + k).a;
-            vec3 normal = unit_voxel_normal(imageLoad(leaf_normal, normal_origin + k).r);
-            vec3 centre = (vec3(child * 2 + k) + 0.5) / n - 0.5;
-            plane += a * vec4(normal, dot(normal, centre));
+            plane += voxel_plane(a, imageLoad(leaf_normal, normal_origin + k).r, child * 2 + k, n);
             coverage += a;
         } else {
             plane += imageLoad(directional, radiance_origin + k + ivec3(int(PLANE_SLOT) * direction_stride, 0, 0));
