@@ -187,33 +187,17 @@ float disc_segment(vec4 plane, vec3 axis, vec3 origin, vec3 dir, float radius) {
 // level's cell (grid units less 0.5). Returns (the most opacity the plane allows, the
 // cells' planarity: |mean opacity x normal| / mean opacity, 1 where the cells' plane is
 // the held one).
-// `shown` is the share of the cells' radiance the cone can see. A surface's light leaves
-// the front of its plane only, and every ray of the cone starts at its origin: where the
-// origin lies behind the cells' plane, the plane's part of the cells (its planarity)
-// shows none. The directional volumes cannot tell: seen edge-on, a surface shows half its
-// light along the axis (anisotropic.glsl, facing) to cones from behind it as from before
-// it, so a wall below the plane of a block's lit top gathered the top's light
-// (`wall_below_a_lit_top_sees_none_of_it`; BENCHMARKS.md, session 43). Only where the
-// cells hold one plane (planarity above 0.9, at most about a tenth of a perpendicular
-// face): the mean plane of a mixture, two walls meeting at an edge, is neither, and
-// hiding its cells darkened Sibenik's first bounce by 2 % everywhere. The plane is known
-// to within a cell (the mean of its voxels' centres): an origin less than half a cell
-// behind it counts as before it.
 vec3 plane_increment(vec3 uvw, float level, vec3 axis, vec3 origin, vec3 dir, float radius, float cell,
-                     float opacity, inout HeldPlane held, out float shown) {
+                     float opacity, inout HeldPlane held) {
     vec4 plane;
     float coverage;
     sample_plane(uvw, level, plane, coverage);
     float len = length(plane.xyz);
-    shown = 1.0;
     if (len < 1e-4 || coverage < 1e-4) {
         return vec3(1.0, 0.0, 0.0);
     }
     float planarity = clamp(len / coverage, 0.0, 1.0);
     plane /= len;
-    if (planarity > 0.9 && dot(plane.xyz, origin) - plane.w < -0.5 * cell) {
-        shown = 1.0 - planarity;
-    }
     float share = disc_segment(plane, axis, origin, dir, radius);
     // The axis crosses the plane where the cells along it hold the surface (`opacity`,
     // the sample's), not past a surface's edge, and the cone sees its face: seen from
@@ -347,9 +331,7 @@ vec4 march_cells(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surf
             vec3 axis = (origin + dir * end - vct.origin.xyz) / grid - 0.5;
             vec3 start_point = (origin - vct.origin.xyz) / grid - 0.5;
             float radius = tan_half * end / grid;
-            float shown;
-            limit = plane_increment(uvw, lod - 1.0, axis, start_point, dir, radius, cell / cells, s.a, held, shown);
-            s.rgb *= shown;
+            limit = plane_increment(uvw, lod - 1.0, axis, start_point, dir, radius, cell / cells, s.a, held);
             if (held.crossed) {
                 float share = disc_segment(held.plane, axis, start_point, dir, radius);
                 least = max(share - held.share, 0.0) / max(1.0 - held.share, 1e-4);
