@@ -846,6 +846,12 @@ fn wall_on_a_lit_floor_matches_the_path_tracer_without_plane_occlusion() {
     );
 }
 
+/// The image row (256 rows, 50° vertical field of view) that shows height `y` of a wall
+/// seen square-on from `distance` before it, by a camera level with its height 0.5.
+fn wall_row(y: f32, distance: f32) -> usize {
+    (127.5 - 256.0 * (y - 0.5) / (2.0 * distance * 25f32.to_radians().tan())).round() as usize
+}
+
 /// The heights above the floor the corner's tests measure at.
 const CORNER_HEIGHTS: [f32; 8] = [0.03, 0.06, 0.1, 0.2, 0.3, 0.4, 0.6, 0.8];
 
@@ -867,11 +873,9 @@ fn wall_on_a_lit_floor_ratios(name: &str, voxels: u32, extra: &[&str]) -> Vec<f3
         &path,
     );
     let (ours, path) = (load_rgb(&ours).unwrap().0, load_rgb(&path).unwrap().0);
-    let row =
-        |y: f32| (127.5 - 256.0 * (y - 0.5) / (3.0 * 25f32.to_radians().tan())).round() as usize;
     let ratios: Vec<f32> = CORNER_HEIGHTS
         .iter()
-        .map(|&y| at_row(&ours, row(y)) / at_row(&path, row(y)))
+        .map(|&y| at_row(&ours, wall_row(y, 1.5)) / at_row(&path, wall_row(y, 1.5)))
         .collect();
     eprintln!(
         "wall on a lit floor {extra:?}, {voxels}³, ours / path tracer at heights \
@@ -1098,11 +1102,9 @@ fn wall_below_a_lit_top(voxels: u32) -> Vec<f32> {
     dense(&scene, voxels, &["--bounces", "1"], &out);
     let (image, _) = load_rgb(&out).unwrap();
     let top = 2.4 / std::f32::consts::PI;
-    let row =
-        |y: f32| (127.5 - 256.0 * (y - 0.5) / (1.8 * 25f32.to_radians().tan())).round() as usize;
     [0.15, 0.3, 0.4]
         .iter()
-        .map(|&y| at_row(&image, row(y)) / top)
+        .map(|&y| at_row(&image, wall_row(y, 0.9)) / top)
         .collect()
 }
 
