@@ -891,6 +891,35 @@ mod tests {
         );
     }
 
+    /// `render` (`--quality accurate`) traces as many bounces as converge unless a count is
+    /// given, on the command line or in the scene file; frames keep theirs.
+    #[test]
+    fn one_image_converges_its_bounces() {
+        let converge = |args: &[&str], scene: &GiOverrides| {
+            let cli = Cli::try_parse_from(args).unwrap();
+            let gi = match cli.command {
+                Some(Command::Render(r)) => r.common.render_settings(scene, Quality::Accurate),
+                Some(Command::View(v)) => v.common.render_settings(scene, Quality::Fast),
+                _ => unreachable!(),
+            };
+            cone_tracing(gi.unwrap()).converge_bounces
+        };
+        let none = GiOverrides::default();
+        assert!(converge(&["voxcone", "render"], &none));
+        assert!(converge(&["voxcone", "render", "--gi", "octree"], &none));
+        assert!(!converge(&["voxcone", "render", "--bounces", "8"], &none));
+        let given = GiOverrides {
+            bounces: Some(3),
+            ..Default::default()
+        };
+        assert!(!converge(&["voxcone", "render"], &given));
+        assert!(!converge(
+            &["voxcone", "render", "--quality", "fast"],
+            &none
+        ));
+        assert!(!converge(&["voxcone", "view"], &none));
+    }
+
     /// `render` draws its shadow maps finer than the frames do, `--quality fast` as the
     /// frames, and the flags win over both.
     #[test]

@@ -617,6 +617,37 @@ fn bounces_over_the_first_match_the_path_tracer() {
     );
 }
 
+/// One image traces its bounces until under 1 % of the indirect light is left
+/// (`converged_bounces`): in the conference room (a closed room, albedo 0.7: 13 bounces)
+/// at 64³ the image's indirect light is within 1 % of 64 bounces'. Eight, the frames'
+/// count and one image's before, leave more than that untraced (there its bounces after
+/// the first fell 5 % short of the path tracer's at 256³; in the Cornell box, open at
+/// the front, eight leave 0.4 %; BENCHMARKS.md, session 44).
+#[test]
+#[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
+fn one_image_traces_its_bounces_until_they_converge() {
+    let scene = shared().join("reference/conference_main.scene.json");
+    let dir = temp_dir("components_converged_bounces");
+    let path = |f: &str| dir.join(f);
+    render_256(&scene, &["--gi", "off"], &path("off.exr"));
+    let indirect = |bounces: Option<&str>| {
+        let name = format!("bounces_{}.exr", bounces.unwrap_or("rule"));
+        let args: Vec<&str> = bounces.map_or(vec![], |b| vec!["--bounces", b]);
+        dense(&scene, 64, &args, &path(&name));
+        block_indirect(&path(&name), &path("off.exr"))
+            .iter()
+            .sum::<f64>()
+    };
+    let most = indirect(Some("64"));
+    let rule = 1.0 - indirect(None) / most;
+    let eight = 1.0 - indirect(Some("8")) / most;
+    eprintln!(
+        "indirect light left untraced, of 64 bounces': the rule's {rule:.4}, eight {eight:.4}"
+    );
+    assert!(rule.abs() < 0.01, "{rule}");
+    assert!(eight > 0.01, "{eight}");
+}
+
 /// A white floor 2 wide (x from -1 to 1) and 20 long between two black walls `height`
 /// high, under a sky of radiance 1, seen from above the floor's middle, as a scene file
 /// in `dir`.
@@ -1537,11 +1568,11 @@ fn flip_does_not_rise_as_the_voxels_get_finer_with_snapped_cones() {
     );
 }
 
-/// The same with `render`'s defaults (the lattice of 72 cones, `render`'s shadow maps):
-/// cornell_point 0.1008 → 0.0844, cornell_area 0.0675 → 0.0563, sponza_main 0.1440 →
-/// 0.1308, sibenik_main 0.0544 → 0.0547, conference_main 0.1866 → 0.1028 (session 40;
-/// Sibenik rose 0.0542 → 0.0573 at session 39, before a turned plane's voxels took its
-/// light).
+/// The same with `render`'s defaults (the lattice of 72 cones, `render`'s shadow maps,
+/// the planes, bounces until they converge): cornell_point 0.0848 → 0.0765, cornell_area
+/// 0.0644 → 0.0571, sponza_main 0.1426 → 0.1263, sibenik_main 0.0559 → 0.0565,
+/// conference_main 0.1751 → 0.0999 (session 44; Sibenik rose 0.0542 → 0.0573 at session
+/// 39, before a turned plane's voxels took its light).
 #[test]
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn flip_does_not_rise_as_the_voxels_get_finer() {

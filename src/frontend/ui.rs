@@ -25,7 +25,7 @@ use crate::gi::path::cli::PathArgs;
 use crate::gi::probes::cli::{ProbeArgs, Switch};
 use crate::gi::vct::cli::VctArgs;
 use crate::gi::vct::voxelize::Voxelizer;
-use crate::gi::vct::{DirectionalFilter, Store, CPU_VOXELS, LATTICE_CONES};
+use crate::gi::vct::{DirectionalFilter, Store, CPU_VOXELS, LATTICE_CONES, MAX_BOUNCES};
 use crate::gi::{DebugView, GiSettings};
 use crate::renderer::{Renderer, FRAMES_IN_FLIGHT};
 use crate::scene::{Light, LightKind};
@@ -446,7 +446,7 @@ fn technique_settings(ui: &mut egui::Ui, view: &mut PanelView) -> bool {
                 !snapped_now,
                 egui::Slider::new(&mut bounce_step, 0.1..=1.0).text("bounce step factor"),
             ));
-            settle(ui.add(egui::Slider::new(&mut bounces, 1..=8).text("bounces")));
+            settle(ui.add(egui::Slider::new(&mut bounces, 1..=MAX_BOUNCES).text("bounces")));
             settle(
                 ui.add(egui::Slider::new(&mut scale, 0..=8).text("indirect scale"))
                     .on_hover_text("trace one pixel of each N×N block; 0: by the image height"),

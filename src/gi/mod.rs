@@ -50,6 +50,15 @@ impl GiSettings {
         match self {
             GiSettings::ConeTracing(vct) => GiSettings::ConeTracing(vct::VctSettings {
                 voxels: vct::Resolution::Count(vct.voxels.on(ctx, scene, &vct.cones)),
+                cones: vct::ConeSettings {
+                    bounces: if vct.converge_bounces {
+                        vct::bounces_for(scene)
+                    } else {
+                        vct.cones.bounces
+                    },
+                    ..vct.cones
+                },
+                converge_bounces: false,
                 ..*vct
             }),
             other => other.clone(),

@@ -361,6 +361,29 @@ impl Scene {
         self.meshes.iter().any(|m| m.animation.is_some())
             || self.lights.iter().any(|l| l.orbit.is_some())
     }
+
+    /// The largest albedo channel of any mesh's material, its texture taken at its mean
+    /// (the 1x1 level, averaged in linear light): what one bounce keeps of the light at
+    /// most, over a whole surface.
+    pub fn brightest_albedo(&self) -> f32 {
+        self.meshes
+            .iter()
+            .filter_map(|mesh| self.materials.get(mesh.material as usize))
+            .map(|material| {
+                let mean = material
+                    .albedo_texture
+                    .and_then(|t| self.textures.get(t as usize))
+                    .and_then(|t| t.mips.last())
+                    .filter(|texel| texel.len() >= 4)
+                    .map_or(Vec3::ONE, |texel| {
+                        let [r, g, b, _] =
+                            crate::imageio::srgba8_decode([texel[0], texel[1], texel[2], texel[3]]);
+                        Vec3::new(r, g, b)
+                    });
+                (material.albedo * mean).max_element()
+            })
+            .fold(0.0, f32::max)
+    }
 }
 
 /// Fixtures shared by the tests of this module's files.

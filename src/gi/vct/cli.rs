@@ -94,8 +94,9 @@ pub struct VctArgs {
     /// last frame's light (the first frame always computes them all).
     #[arg(long)]
     pub no_accumulate: bool,
-    /// Light bounces between voxels, 1 to 8 (1: direct light on the voxels only)
-    /// [default: 8].
+    /// Light bounces between voxels, 1 to 64 (1: direct light on the voxels only)
+    /// [default: 8 for frames; for one image (`render`) as many as leave under 1 % of the
+    /// light untraced, from the scene's brightest albedo].
     #[arg(long)]
     pub bounces: Option<u32>,
     /// Shadow the direct light with soft-shadow cones through the voxels instead of with
@@ -360,6 +361,8 @@ impl VctArgs {
             voxels,
             store,
             cones,
+            converge_bounces: quality == Quality::Accurate
+                && self.bounces.or(scene.bounces).is_none(),
             shadow_cones: self.shadow_cones || scene.shadow_cones.unwrap_or(false),
             full_update: self.full_update,
             voxelizer: self.voxelizer,

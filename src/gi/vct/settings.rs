@@ -188,6 +188,54 @@ pub fn auto_voxels(memory: Option<u64>, extent: f32, size: Option<f32>, finer_he
     }
 }
 
+/// The most voxel bounces (`--bounces`, and [`converged_bounces`]'s).
+pub const MAX_BOUNCES: u32 = 64;
+
+/// The share of the indirect light one image may leave in the bounces it does not trace.
+const BOUNCE_REMAINDER: f32 = 0.01;
+
+/// Voxel bounces ([`ConeSettings::bounces`]) for one image where none are given: the
+/// fewest that leave under [`BOUNCE_REMAINDER`] of the indirect light untraced where every
+/// surface reflects `albedo` (the scene's brightest, [`Scene::brightest_albedo`]). With
+/// `bounces` the image holds that many bounces of indirect light (the voxels one fewer,
+/// the screen's gather one more), and bounce k carries at most albedo^(k-1) of the
+/// first's light, so what is left is at most albedo^bounces of it all. Frames need no
+/// more than their default: each adds a bounce to the last frame's light. One image at
+/// eight left the conference room's bounces after the first 5 % short of the path
+/// tracer's at 256³ (its albedo 0.7: 13 bounces; BENCHMARKS.md, session 44).
+pub fn converged_bounces(albedo: f32) -> u32 {
+    if albedo <= 0.0 {
+        return 1;
+    }
+    if albedo >= 1.0 {
+        return MAX_BOUNCES;
+    }
+    // Finite and positive: both logarithms are negative.
+    (BOUNCE_REMAINDER.ln() / albedo.ln())
+        .ceil()
+        .clamp(1.0, MAX_BOUNCES as f32) as u32
+}
+
+/// [`converged_bounces`] for `scene`, logged with the reason.
+pub fn bounces_for(scene: &Scene) -> u32 {
+    let albedo = scene.brightest_albedo();
+    let bounces = converged_bounces(albedo);
+    if albedo >= 1.0 {
+        log::warn!(
+            "bounces: {bounces}, the most: a material reflects all the light ({albedo:.3}), so \
+             no count of bounces leaves under {:.0} % of it untraced",
+            BOUNCE_REMAINDER * 100.0
+        );
+    } else {
+        log::info!(
+            "bounces: {bounces} (one image: under {:.0} % of the indirect light left untraced \
+             where every surface reflects as the brightest material, {albedo:.3})",
+            BOUNCE_REMAINDER * 100.0
+        );
+    }
+    bounces
+}
+
 /// Checks a wanted voxel size.
 pub fn check_voxel_size(size: f32) -> Result<()> {
     if !(size.is_finite() && size > 0.0) {
@@ -202,6 +250,9 @@ pub struct VctSettings {
     pub voxels: Resolution,
     pub store: Store,
     pub cones: ConeSettings,
+    /// One image without a given count: `cones.bounces` becomes [`converged_bounces`] for
+    /// the scene ([`crate::gi::GiSettings::on`]).
+    pub converge_bounces: bool,
     /// Direct light shadowed by soft-shadow cones through the voxels instead of by the
     /// shadow maps (which still light the voxels).
     pub shadow_cones: bool,
@@ -223,6 +274,7 @@ impl VctSettings {
             voxels: Resolution::Count(voxels),
             store,
             cones: ConeSettings::default(),
+            converge_bounces: false,
             shadow_cones: false,
             full_update: false,
             voxelizer: Voxelizer::default(),
@@ -266,7 +318,8 @@ pub struct ConeSettings {
     /// counting alike, in the screen's gather (the voxel bounce keeps the ring). It reads
     /// the voxels as `snapped_cones` does (which it implies).
     pub lattice_cones: u32,
-    /// Light bounces between voxels: 1 is direct light on the voxels only.
+    /// Light bounces between voxels: 1 is direct light on the voxels only; for one image
+    /// without a given count as many as converge ([`converged_bounces`]).
     pub bounces: u32,
     /// Indirect light is traced on one pixel of each `indirect_scale`² block and
     /// upsampled; `None` picks it from the image height ([`auto_indirect_scale`]).
@@ -327,7 +380,7 @@ impl ConeSettings {
         }
         let counts = [
             (self.diffuse_cones, 1, 16, "--diffuse-cones / diffuse_cones"),
-            (self.bounces, 1, 8, "--bounces / bounces"),
+            (self.bounces, 1, MAX_BOUNCES, "--bounces / bounces"),
             (
                 self.indirect_scale.unwrap_or(1),
                 1,
@@ -423,5 +476,25 @@ mod tests {
             auto_voxels(Some(80 * GIB), 1e30, Some(1e-30), false),
             MOST_VOXELS
         );
+    }
+
+    /// The fewest bounces whose untraced rest, at most albedo^bounces of the indirect
+    /// light, is under the remainder: one fewer would leave more; none where nothing
+    /// reflects, the most where everything does.
+    #[test]
+    fn converged_bounces_leave_under_the_remainder() {
+        assert_eq!(converged_bounces(0.7), 13);
+        assert_eq!(converged_bounces(0.78), 19);
+        for albedo in [0.05, 0.3, 0.5, 0.7, 0.8, 0.9] {
+            let bounces = converged_bounces(albedo);
+            assert!(albedo.powi(bounces as i32) < BOUNCE_REMAINDER, "{albedo}");
+            assert!(
+                albedo.powi(bounces as i32 - 1) >= BOUNCE_REMAINDER,
+                "{albedo}"
+            );
+        }
+        assert_eq!(converged_bounces(0.0), 1);
+        assert_eq!(converged_bounces(0.99), MAX_BOUNCES);
+        assert_eq!(converged_bounces(1.0), MAX_BOUNCES);
     }
 }

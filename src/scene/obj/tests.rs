@@ -1,7 +1,7 @@
 use std::time::Instant;
 
 use super::super::testing::{error_text, shared_dir, write_quad, TempDir};
-use super::super::{Aabb, Texture, Vertex};
+use super::super::{Aabb, Scene, Texture, Vertex};
 use super::*;
 
 fn load(path: &Path, options: &LoadOptions) -> Result<(Vec<Mesh>, Vec<Material>, Vec<Texture>)> {
@@ -264,4 +264,14 @@ fn sponza() {
     assert!(meshes
         .iter()
         .all(|m| (m.material as usize) < materials.len()));
+}
+
+/// The brightest albedo takes a textured material's Kd times its texture's mean: the
+/// quad's texture is sRGB (255, 128, 0), linear (1, 0.216, 0), under Kd 0.5.
+#[test]
+fn brightest_albedo_takes_the_texture_at_its_mean() {
+    let dir = TempDir::new("brightest");
+    let obj = write_quad(&dir.0);
+    let scene = Scene::load(&obj, &LoadOptions::default()).unwrap();
+    assert!((scene.brightest_albedo() - 0.5).abs() < 1e-6);
 }

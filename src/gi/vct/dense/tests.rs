@@ -6,7 +6,8 @@ use std::sync::Arc;
 use super::super::reference;
 use super::super::voxelize::Voxelizer;
 use super::super::{
-    auto_voxels, DirectionalFilter, Grid, Quality, Resolution, Store, CPU_VOXELS, LATTICE_CONES,
+    auto_voxels, converged_bounces, ConeSettings, DirectionalFilter, Grid, Quality, Resolution,
+    Store, CPU_VOXELS, LATTICE_CONES,
 };
 use super::Volume;
 use crate::gi::GiSettings;
@@ -439,6 +440,24 @@ fn voxel_list_holds_exactly_the_occupied_voxels() {
     assert!(count > 0);
     assert_eq!(listed, occupied);
     assert_eq!(ctx.validation_messages(), 0);
+}
+
+/// One image without a given count of bounces takes the rule's for its scene (the built-in
+/// box: its brightest albedo 0.78, 19) and keeps the count in its settings.
+#[test]
+fn converged_bounces_reach_the_renderer() {
+    let scene = Scene::load(&crate::cli::default_scene(), &LoadOptions::default()).unwrap();
+    let want = converged_bounces(scene.brightest_albedo());
+    assert!(want > ConeSettings::default().bounces, "{want}");
+    let mut settings = gi_settings(CPU_VOXELS, DENSE, false);
+    cone_settings(&mut settings).converge_bounces = true;
+    let (ctx, renderer) = render_frames(scene, settings, &[0.0]);
+    assert_eq!(ctx.validation_messages(), 0);
+    let GiSettings::ConeTracing(kept) = &renderer.settings.gi else {
+        panic!("no cone tracing");
+    };
+    assert_eq!(kept.cones.bounces, want);
+    assert!(!kept.converge_bounces);
 }
 
 /// Without a given resolution the renderer applies the rule for its device, keeps the
