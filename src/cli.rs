@@ -621,11 +621,13 @@ mod tests {
         assert!(text.contains("magic") && text.contains("off"), "{text}");
     }
 
-    /// The settings `render` makes of the command line `args` with the scene file's `[gi]`
-    /// table `scene`.
-    fn render(args: &[&str], scene: &GiOverrides) -> Result<RenderSettings> {
+    /// The settings the command line `args` (`render`, `view` or `bench`) makes with the
+    /// scene file's `[gi]` table `scene`: one image accurate, frames fast.
+    fn settings_of(args: &[&str], scene: &GiOverrides) -> Result<RenderSettings> {
         match Cli::try_parse_from(args).unwrap().command {
             Some(Command::Render(r)) => r.common.render_settings(scene, Quality::Accurate),
+            Some(Command::View(v)) => v.common.render_settings(scene, Quality::Fast),
+            Some(Command::Bench(b)) => b.common.render_settings(scene, Quality::Fast),
             _ => unreachable!(),
         }
     }
@@ -638,7 +640,7 @@ mod tests {
             shadow_cones: Some(true),
             ..Default::default()
         };
-        let parse = |args: &[&str]| render(args, &scene).unwrap();
+        let parse = |args: &[&str]| settings_of(args, &scene).unwrap();
         let gi = cone_tracing(parse(&["voxcone", "render"]));
         assert_eq!(
             (gi.voxels, gi.cones.diffuse_cones),
@@ -664,7 +666,7 @@ mod tests {
     /// file; without either the device decides (`Resolution::Auto`).
     #[test]
     fn voxels_come_from_a_count_a_size_or_the_device() {
-        let parse = |scene: GiOverrides, args: &[&str]| render(args, &scene).map(cone_tracing);
+        let parse = |scene: GiOverrides, args: &[&str]| settings_of(args, &scene).map(cone_tracing);
         let none = GiOverrides::default();
         let sized = GiOverrides {
             voxel_size: Some(0.5),
@@ -712,7 +714,7 @@ mod tests {
     /// without `--cone` the layout's options are still the voxels' alone.
     #[test]
     fn path_cone_takes_the_gathers_layout() {
-        let parse = |args: &[&str]| render(args, &GiOverrides::default());
+        let parse = |args: &[&str]| settings_of(args, &GiOverrides::default());
         let settings = parse(&[
             "voxcone",
             "render",
@@ -752,7 +754,7 @@ mod tests {
     /// and components it refuses; snapped cones refuse the steps' options.
     #[test]
     fn lattice_replaces_the_ring() {
-        let parse = |args: &[&str]| render(args, &GiOverrides::default());
+        let parse = |args: &[&str]| settings_of(args, &GiOverrides::default());
         let gi = cone_tracing(parse(&["voxcone", "render", "--lattice-cones", "72"]).unwrap());
         assert_eq!(gi.cones.lattice_cones, 72);
         assert!(gi.cones.snapped_cones);
@@ -838,14 +840,7 @@ mod tests {
     #[test]
     fn one_image_is_accurate_frames_are_fast() {
         let settings = |args: &[&str], scene: &GiOverrides| {
-            let cli = Cli::try_parse_from(args).unwrap();
-            let gi = match cli.command {
-                Some(Command::Render(r)) => r.common.render_settings(scene, Quality::Accurate),
-                Some(Command::View(v)) => v.common.render_settings(scene, Quality::Fast),
-                Some(Command::Bench(b)) => b.common.render_settings(scene, Quality::Fast),
-                _ => unreachable!(),
-            };
-            let gi = cone_tracing(gi.unwrap());
+            let gi = cone_tracing(settings_of(args, scene).unwrap());
             let Resolution::Auto { quality, .. } = gi.voxels else {
                 panic!("a given resolution");
             };
@@ -880,7 +875,7 @@ mod tests {
         assert_eq!(settings(&cone, &none), (0, Quality::Accurate));
         let octree = ["voxcone", "render", "--gi", "octree"];
         assert_eq!(settings(&octree, &none), accurate);
-        let error = render(
+        let error = settings_of(
             &["voxcone", "render", "--gi", "off", "--quality", "fast"],
             &none,
         )
@@ -896,13 +891,7 @@ mod tests {
     #[test]
     fn one_image_converges_its_bounces() {
         let converge = |args: &[&str], scene: &GiOverrides| {
-            let cli = Cli::try_parse_from(args).unwrap();
-            let gi = match cli.command {
-                Some(Command::Render(r)) => r.common.render_settings(scene, Quality::Accurate),
-                Some(Command::View(v)) => v.common.render_settings(scene, Quality::Fast),
-                _ => unreachable!(),
-            };
-            cone_tracing(gi.unwrap()).converge_bounces
+            cone_tracing(settings_of(args, scene).unwrap()).converge_bounces
         };
         let none = GiOverrides::default();
         assert!(converge(&["voxcone", "render"], &none));
@@ -960,7 +949,7 @@ mod tests {
 
     #[test]
     fn rows_filter_the_dense_grid_only() {
-        let parse = |args: &[&str]| render(args, &GiOverrides::default());
+        let parse = |args: &[&str]| settings_of(args, &GiOverrides::default());
         let gi =
             cone_tracing(parse(&["voxcone", "render", "--directional-filter", "rows"]).unwrap());
         assert_eq!(
@@ -986,7 +975,7 @@ mod tests {
     fn planes_wherever_pairs_and_snapped_cones_meet() {
         let planes = |args: &[&str]| {
             let args = [&["voxcone", "render"][..], args].concat();
-            cone_tracing(render(&args, &GiOverrides::default()).unwrap())
+            cone_tracing(settings_of(&args, &GiOverrides::default()).unwrap())
                 .store
                 .planes()
         };
@@ -1005,7 +994,7 @@ mod tests {
             bounce_step_factor: Some(0.4),
             ..Default::default()
         };
-        let parse = |args: &[&str]| render(args, &scene);
+        let parse = |args: &[&str]| settings_of(args, &scene);
         let gi =
             cone_tracing(parse(&["voxcone", "render", "--shadow-step-factor", "0.3"]).unwrap());
         let d = ConeSettings::default();
