@@ -362,27 +362,50 @@ impl Scene {
             || self.lights.iter().any(|l| l.orbit.is_some())
     }
 
-    /// The largest albedo channel of any mesh's material, its texture taken at its mean
-    /// (the 1x1 level, averaged in linear light): what one bounce keeps of the light at
-    /// most, over a whole surface.
-    pub fn brightest_albedo(&self) -> f32 {
-        self.meshes
-            .iter()
-            .filter_map(|mesh| self.materials.get(mesh.material as usize))
-            .map(|material| {
-                let mean = material
-                    .albedo_texture
-                    .and_then(|t| self.textures.get(t as usize))
-                    .and_then(|t| t.mips.last())
-                    .filter(|texel| texel.len() >= 4)
-                    .map_or(Vec3::ONE, |texel| {
-                        let [r, g, b, _] =
-                            crate::imageio::srgba8_decode([texel[0], texel[1], texel[2], texel[3]]);
-                        Vec3::new(r, g, b)
-                    });
-                (material.albedo * mean).max_element()
-            })
-            .fold(0.0, f32::max)
+    /// The mean albedo of the scene's surfaces, weighted by their area (at time 0): each
+    /// material's largest channel of Kd times its texture's mean (the 1x1 level, averaged
+    /// in linear light). What a bounce keeps of the light in an integrating sphere, where
+    /// every surface receives alike: a closed room's later bounces fall by about this
+    /// much each.
+    pub fn mean_albedo(&self) -> f32 {
+        let mut weighted = 0.0f64;
+        let mut total = 0.0f64;
+        for (i, mesh) in self.meshes.iter().enumerate() {
+            let Some(material) = self.materials.get(mesh.material as usize) else {
+                continue;
+            };
+            let mean = material
+                .albedo_texture
+                .and_then(|t| self.textures.get(t as usize))
+                .and_then(|t| t.mips.last())
+                .filter(|texel| texel.len() >= 4)
+                .map_or(Vec3::ONE, |texel| {
+                    let [r, g, b, _] =
+                        crate::imageio::srgba8_decode([texel[0], texel[1], texel[2], texel[3]]);
+                    Vec3::new(r, g, b)
+                });
+            let albedo = f64::from((material.albedo * mean).max_element());
+            let transform = self.mesh_transform(i, 0.0);
+            let area: f64 = mesh
+                .indices
+                .chunks_exact(3)
+                .filter_map(|t| {
+                    let corner = |k: usize| {
+                        let v = mesh.vertices.get(t[k] as usize)?;
+                        Some(transform.transform_point3(Vec3::from(v.position)))
+                    };
+                    let (a, b, c) = (corner(0)?, corner(1)?, corner(2)?);
+                    Some(f64::from(0.5 * (b - a).cross(c - a).length()))
+                })
+                .sum();
+            weighted += albedo * area;
+            total += area;
+        }
+        if total > 0.0 {
+            (weighted / total) as f32
+        } else {
+            0.0
+        }
     }
 }
 

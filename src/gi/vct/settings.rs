@@ -195,14 +195,16 @@ pub const MAX_BOUNCES: u32 = 64;
 const BOUNCE_REMAINDER: f32 = 0.01;
 
 /// Voxel bounces ([`ConeSettings::bounces`]) for one image where none are given: the
-/// fewest that leave under [`BOUNCE_REMAINDER`] of the indirect light untraced where every
-/// surface reflects `albedo` (the scene's brightest, [`Scene::brightest_albedo`]). With
-/// `bounces` the image holds that many bounces of indirect light (the voxels one fewer,
-/// the screen's gather one more), and bounce k carries at most albedo^(k-1) of the
-/// first's light, so what is left is at most albedo^bounces of it all. Frames need no
-/// more than their default: each adds a bounce to the last frame's light. One image at
-/// eight left the conference room's bounces after the first 5 % short of the path
-/// tracer's at 256³ (its albedo 0.7: 13 bounces; BENCHMARKS.md, session 44).
+/// fewest that leave under [`BOUNCE_REMAINDER`] of the indirect light untraced where each
+/// bounce keeps `albedo` of the light (the scene's area-weighted mean,
+/// [`Scene::mean_albedo`], as in an integrating sphere). With `bounces` the image holds
+/// that many bounces of indirect light (the voxels one fewer, the screen's gather one
+/// more), and bounce k carries albedo^(k-1) of the first's light, so what is left is
+/// albedo^bounces of it all. The brightest material's albedo would bound it, but a small
+/// white object in a dark room then asks for dozens of bounces that carry nothing.
+/// Frames need no more than their default: each adds a bounce to the last frame's light.
+/// One image at eight left the conference room's bounces after the first 5 % short of
+/// the path tracer's at 256³ (its albedo 0.7: 13 bounces; BENCHMARKS.md, session 44).
 pub fn converged_bounces(albedo: f32) -> u32 {
     if albedo <= 0.0 {
         return 1;
@@ -218,18 +220,18 @@ pub fn converged_bounces(albedo: f32) -> u32 {
 
 /// [`converged_bounces`] for `scene`, logged with the reason.
 pub fn bounces_for(scene: &Scene) -> u32 {
-    let albedo = scene.brightest_albedo();
+    let albedo = scene.mean_albedo();
     let bounces = converged_bounces(albedo);
     if albedo >= 1.0 {
         log::warn!(
-            "bounces: {bounces}, the most: a material reflects all the light ({albedo:.3}), so \
-             no count of bounces leaves under {:.0} % of it untraced",
+            "bounces: {bounces}, the most: the surfaces reflect all the light ({albedo:.3}), \
+             so no count of bounces leaves under {:.0} % of it untraced",
             BOUNCE_REMAINDER * 100.0
         );
     } else {
         log::info!(
             "bounces: {bounces} (one image: under {:.0} % of the indirect light left untraced \
-             where every surface reflects as the brightest material, {albedo:.3})",
+             where each bounce keeps the surfaces' mean albedo, {albedo:.3})",
             BOUNCE_REMAINDER * 100.0
         );
     }
@@ -478,8 +480,8 @@ mod tests {
         );
     }
 
-    /// The fewest bounces whose untraced rest, at most albedo^bounces of the indirect
-    /// light, is under the remainder: one fewer would leave more; none where nothing
+    /// The fewest bounces whose untraced rest, albedo^bounces of the indirect light, is
+    /// under the remainder: one fewer would leave more; none where nothing
     /// reflects, the most where everything does.
     #[test]
     fn converged_bounces_leave_under_the_remainder() {

@@ -266,12 +266,28 @@ fn sponza() {
         .all(|m| (m.material as usize) < materials.len()));
 }
 
-/// The brightest albedo takes a textured material's Kd times its texture's mean: the
-/// quad's texture is sRGB (255, 128, 0), linear (1, 0.216, 0), under Kd 0.5.
+/// The mean albedo takes a textured material's Kd times its texture's mean (the quad's
+/// texture is sRGB (255, 128, 0), linear (1, 0.216, 0), under Kd 0.5), and weighs the
+/// materials by their area: a black quad three times as large beside it leaves a quarter.
 #[test]
-fn brightest_albedo_takes_the_texture_at_its_mean() {
-    let dir = TempDir::new("brightest");
-    let obj = write_quad(&dir.0);
-    let scene = Scene::load(&obj, &LoadOptions::default()).unwrap();
-    assert!((scene.brightest_albedo() - 0.5).abs() < 1e-6);
+fn mean_albedo_weighs_the_textures_means_by_area() {
+    let dir = TempDir::new("albedo");
+    let quad = write_quad(&dir.0);
+    let scene = Scene::load(&quad, &LoadOptions::default()).unwrap();
+    assert!((scene.mean_albedo() - 0.5).abs() < 1e-6);
+    dir.write("black.mtl", "newmtl black\nKd 0 0 0\n");
+    dir.write(
+        "black.obj",
+        "mtllib black.mtl\nv 0 0 1\nv 3 0 1\nv 3 1 1\nv 0 1 1\nusemtl black\nf 1 2 3 4\n",
+    );
+    let both = dir.write(
+        "both.toml",
+        "[[mesh]]\npath = \"quad.obj\"\n[[mesh]]\npath = \"black.obj\"\n",
+    );
+    let scene = Scene::load(&both, &LoadOptions::default()).unwrap();
+    assert!(
+        (scene.mean_albedo() - 0.125).abs() < 1e-6,
+        "{}",
+        scene.mean_albedo()
+    );
 }

@@ -443,11 +443,11 @@ fn voxel_list_holds_exactly_the_occupied_voxels() {
 }
 
 /// One image without a given count of bounces takes the rule's for its scene (the built-in
-/// box: its brightest albedo 0.78, 19) and keeps the count in its settings.
+/// box, more than the frames' eight) and keeps the count in its settings.
 #[test]
 fn converged_bounces_reach_the_renderer() {
     let scene = Scene::load(&crate::cli::default_scene(), &LoadOptions::default()).unwrap();
-    let want = converged_bounces(scene.brightest_albedo());
+    let want = converged_bounces(scene.mean_albedo());
     assert!(want > ConeSettings::default().bounces, "{want}");
     let mut settings = gi_settings(CPU_VOXELS, DENSE, false);
     cone_settings(&mut settings).converge_bounces = true;
