@@ -362,6 +362,21 @@ impl Scene {
             || self.lights.iter().any(|l| l.orbit.is_some())
     }
 
+    /// The area of mesh `mesh`'s triangles in the world at time 0.
+    pub fn mesh_area(&self, mesh: usize) -> f64 {
+        let model = self.mesh_transform(mesh, 0.0);
+        let mesh = &self.meshes[mesh];
+        mesh.indices
+            .chunks_exact(3)
+            .map(|t| {
+                let p = [t[0], t[1], t[2]].map(|i| {
+                    model.transform_point3(Vec3::from(mesh.vertices[i as usize].position))
+                });
+                f64::from((p[1] - p[0]).cross(p[2] - p[0]).length() * 0.5)
+            })
+            .sum()
+    }
+
     /// The mean albedo of the scene's surfaces, weighted by their area (at time 0): each
     /// material's largest channel of Kd times its texture's mean (the 1x1 level, averaged
     /// in linear light). What a bounce keeps of the light in an integrating sphere, where
@@ -371,33 +386,15 @@ impl Scene {
         let mut weighted = 0.0f64;
         let mut total = 0.0f64;
         for (i, mesh) in self.meshes.iter().enumerate() {
-            let Some(material) = self.materials.get(mesh.material as usize) else {
-                continue;
-            };
-            let mean = material
-                .albedo_texture
-                .and_then(|t| self.textures.get(t as usize))
-                .and_then(|t| t.mips.last())
-                .filter(|texel| texel.len() >= 4)
-                .map_or(Vec3::ONE, |texel| {
-                    let [r, g, b, _] =
-                        crate::imageio::srgba8_decode([texel[0], texel[1], texel[2], texel[3]]);
-                    Vec3::new(r, g, b)
-                });
+            let material = &self.materials[mesh.material as usize];
+            let mean = material.albedo_texture.map_or(Vec3::ONE, |t| {
+                let texel = &self.textures[t as usize].mips.last().expect("a 1x1 level")[..4];
+                let [r, g, b, _] =
+                    crate::imageio::srgba8_decode([texel[0], texel[1], texel[2], texel[3]]);
+                Vec3::new(r, g, b)
+            });
             let albedo = f64::from((material.albedo * mean).max_element());
-            let transform = self.mesh_transform(i, 0.0);
-            let area: f64 = mesh
-                .indices
-                .chunks_exact(3)
-                .filter_map(|t| {
-                    let corner = |k: usize| {
-                        let v = mesh.vertices.get(t[k] as usize)?;
-                        Some(transform.transform_point3(Vec3::from(v.position)))
-                    };
-                    let (a, b, c) = (corner(0)?, corner(1)?, corner(2)?);
-                    Some(f64::from(0.5 * (b - a).cross(c - a).length()))
-                })
-                .sum();
+            let area = self.mesh_area(i);
             weighted += albedo * area;
             total += area;
         }

@@ -33,18 +33,12 @@ impl Capacities {
     /// so one regrowth sizes a pool exactly. Wrong guesses cost a rebuild of the octree
     /// (not of the fragments), never a wrong image.
     pub fn estimate(scene: &Scene, grid: &Grid) -> Self {
-        let mut area = 0.0f64;
-        let mut triangles = 0u64;
-        for (m, mesh) in scene.meshes.iter().enumerate() {
-            let model = scene.mesh_transform(m, 0.0);
-            for t in mesh.indices.chunks_exact(3) {
-                let p = [t[0], t[1], t[2]].map(|i| {
-                    model.transform_point3(glam::Vec3::from(mesh.vertices[i as usize].position))
-                });
-                area += f64::from((p[1] - p[0]).cross(p[2] - p[0]).length() * 0.5);
-                triangles += 1;
-            }
-        }
+        let area: f64 = (0..scene.meshes.len()).map(|m| scene.mesh_area(m)).sum();
+        let triangles: u64 = scene
+            .meshes
+            .iter()
+            .map(|m| m.indices.len() as u64 / 3)
+            .sum();
         let face = f64::from(grid.voxel_size).powi(2);
         let fragments = (3.0 * area / face + 2.0 * triangles as f64).max(4096.0);
         Self::for_fragments(fragments.min(f64::from(u32::MAX / 2)) as u32)
