@@ -8,6 +8,7 @@ use crate::frontend::{Offscreen, LDR_FORMAT};
 use crate::gi::vct::voxelize::Voxelizer;
 use crate::gi::vct::{ConeTracing, Dense, Octree, Store, VctSettings};
 use crate::gi::GiSettings;
+pub use crate::ray::host::Random;
 use crate::renderer::{OutputTarget, Renderer};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -155,26 +156,4 @@ pub fn moving_cube_scene(cornell: &std::path::Path, dir: &std::path::Path, glow:
     )
     .unwrap();
     Scene::load(&scene_file, &crate::scene::LoadOptions::default()).unwrap()
-}
-
-/// A small deterministic generator (xorshift), so that random cases are the same every
-/// run.
-pub struct Random(pub u64);
-
-impl Random {
-    /// Uniform in [0, 1).
-    pub fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    /// Uniform on the unit sphere.
-    pub fn direction(&mut self) -> glam::Vec3 {
-        let z = 2.0 * self.next() - 1.0;
-        let phi = std::f32::consts::TAU * self.next();
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        glam::Vec3::new(r * phi.cos(), r * phi.sin(), z)
-    }
 }

@@ -6,9 +6,11 @@ use std::sync::Arc;
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::host::bounce_rate;
 use super::query::RayQueries;
 use super::surfaces::check_buffer_size;
 use super::{SceneRays, Triangles};
+use crate::gi::vct::converged_bounces;
 use crate::gpu_layout::{RayHit, RayQuery, RAY_ANY, RAY_CLOSEST, RAY_NONE};
 use crate::scene::testing::{shared_file, TempDir};
 use crate::scene::{LoadOptions, Scene};
@@ -261,7 +263,7 @@ fn ray_caster_matches_brute_force_on_sponza() {
         .map(|_| {
             let o = bounds.min
                 + (bounds.max - bounds.min)
-                    * Vec3::new(random.next(), random.next(), random.next());
+                    * Vec3::new(random.unit(), random.unit(), random.unit());
             query(o, random.direction(), RAY_CLOSEST)
         })
         .collect();
@@ -271,7 +273,7 @@ fn ray_caster_matches_brute_force_on_sponza() {
     let up = right.cross(forward);
     let half = (camera.fov_y_deg.to_radians() * 0.5).tan();
     for _ in 0..100_000 {
-        let (x, y) = (2.0 * random.next() - 1.0, 2.0 * random.next() - 1.0);
+        let (x, y) = (2.0 * random.unit() - 1.0, 2.0 * random.unit() - 1.0);
         let d = forward + right * (x * half) + up * (y * half);
         queries.push(query(camera.position, d, RAY_CLOSEST));
     }
@@ -397,4 +399,78 @@ fn a_buffer_beyond_the_device_limit_is_refused_with_its_size() {
     ] {
         assert!(error.contains(part), "{error:?} lacks {part:?}");
     }
+}
+
+/// The six faces of the cube from -`h` to `h` on each axis as OBJ text, its vertices
+/// numbered from `first` (1-based); `open_front` leaves out the face at z = `h`.
+fn cube_obj(h: f32, first: usize, material: &str, open_front: bool) -> String {
+    let mut text = format!("usemtl {material}\n");
+    for i in 0..8 {
+        let at = |bit: usize| if i & bit != 0 { h } else { -h };
+        text += &format!("v {} {} {}\n", at(1), at(2), at(4));
+    }
+    let faces: &[[usize; 4]] = &[
+        [0, 2, 6, 4],
+        [1, 3, 7, 5],
+        [0, 1, 5, 4],
+        [2, 3, 7, 6],
+        [0, 1, 3, 2],
+        [4, 5, 7, 6],
+    ];
+    for face in &faces[..if open_front { 5 } else { 6 }] {
+        let [a, b, c, d] = face.map(|v| v + first);
+        text += &format!("f {a} {b} {c} {d}\n");
+    }
+    text
+}
+
+/// [`bounce_rate`] of `obj` (materials `grey` 0.6, `white` 1, `black` 0) seen from
+/// `position` towards the origin.
+fn rate_of(obj: &str, position: Vec3) -> f32 {
+    let dir = TempDir::new("bounce_rate");
+    dir.write(
+        "box.mtl",
+        "newmtl grey\nKd 0.6 0.6 0.6\nnewmtl white\nKd 1 1 1\nnewmtl black\nKd 0 0 0\n",
+    );
+    dir.write("box.obj", &format!("mtllib box.mtl\n{obj}"));
+    let scene = dir.write(
+        "box.toml",
+        &format!(
+            "[camera]\nposition = [{}, {}, {}]\ntarget = [0, 0, 0]\nfov_y_deg = 60\n\
+             [[mesh]]\npath = \"box.obj\"\n",
+            position.x, position.y, position.z
+        ),
+    );
+    bounce_rate(&Scene::load(&scene, &LoadOptions::default()).unwrap())
+}
+
+/// What a bounce passes on, measured along the camera's walks, against the cases whose
+/// answer is known: a closed box of albedo 0.6 passes on 0.6 (every ray meets a wall); a
+/// white plane under the sky nothing (every ray from it escapes); a white cube in a black
+/// box nothing (its light meets only black, and the cube's inside, which no walk reaches,
+/// does not count though it would pass on all); the grey box open at the front, seen from
+/// outside, less than closed, more than half of it (a face's share of a cube's inside is
+/// 0.2).
+#[test]
+fn bounce_rate_is_the_albedo_in_a_closed_box_and_nothing_in_the_open() {
+    let closed = rate_of(&cube_obj(1.0, 1, "grey", false), Vec3::new(0.2, 0.1, 0.5));
+    assert!((closed - 0.6).abs() < 0.005, "closed box {closed}");
+    let plane = rate_of(
+        "usemtl white\nv -5 0 -5\nv 5 0 -5\nv 5 0 5\nv -5 0 5\nf 1 2 3 4\n",
+        Vec3::new(0.0, 2.0, 0.1),
+    );
+    assert_eq!(plane, 0.0, "open plane");
+    let cube_in_black = rate_of(
+        &(cube_obj(2.0, 1, "black", false) + &cube_obj(0.3, 9, "white", false)),
+        Vec3::new(0.3, 0.4, 1.5),
+    );
+    assert_eq!(cube_in_black, 0.0, "white cube in a black box");
+    let open = rate_of(&cube_obj(1.0, 1, "grey", true), Vec3::new(0.1, 0.2, 3.0));
+    eprintln!(
+        "bounce rate: closed box {closed:.4}, plane {plane}, white cube in black \
+         {cube_in_black}, open box {open:.4}"
+    );
+    assert!(open > 0.3 && open < 0.57, "open box {open}");
+    assert_eq!(converged_bounces(plane), 1);
+    assert_eq!(converged_bounces(closed), 10);
 }

@@ -377,32 +377,17 @@ impl Scene {
             .sum()
     }
 
-    /// The mean albedo of the scene's surfaces, weighted by their area (at time 0): each
-    /// material's largest channel of Kd times its texture's mean (the 1x1 level, averaged
-    /// in linear light). What a bounce keeps of the light in an integrating sphere, where
-    /// every surface receives alike: a closed room's later bounces fall by about this
-    /// much each.
-    pub fn mean_albedo(&self) -> f32 {
-        let mut weighted = 0.0f64;
-        let mut total = 0.0f64;
-        for (i, mesh) in self.meshes.iter().enumerate() {
-            let material = &self.materials[mesh.material as usize];
-            let mean = material.albedo_texture.map_or(Vec3::ONE, |t| {
-                let texel = &self.textures[t as usize].mips.last().expect("a 1x1 level")[..4];
-                let [r, g, b, _] =
-                    crate::imageio::srgba8_decode([texel[0], texel[1], texel[2], texel[3]]);
-                Vec3::new(r, g, b)
-            });
-            let albedo = f64::from((material.albedo * mean).max_element());
-            let area = self.mesh_area(i);
-            weighted += albedo * area;
-            total += area;
-        }
-        if total > 0.0 {
-            (weighted / total) as f32
-        } else {
-            0.0
-        }
+    /// The mean albedo of material `material`: its Kd times its texture's mean (the 1x1
+    /// level, averaged in linear light).
+    pub fn material_albedo(&self, material: u32) -> Vec3 {
+        let material = &self.materials[material as usize];
+        let mean = material.albedo_texture.map_or(Vec3::ONE, |t| {
+            let texel = &self.textures[t as usize].mips.last().expect("a 1x1 level")[..4];
+            let [r, g, b, _] =
+                crate::imageio::srgba8_decode([texel[0], texel[1], texel[2], texel[3]]);
+            Vec3::new(r, g, b)
+        });
+        material.albedo * mean
     }
 }
 

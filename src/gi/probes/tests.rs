@@ -1124,12 +1124,12 @@ fn a_lookup_reads_no_finer_level_than_its_cluster() {
     let mut zoned = 0;
     for _ in 0..2000 {
         let camera = LodCamera {
-            position: Vec3::new(random.next(), random.next(), random.next()) * 4.0 - 2.0,
+            position: Vec3::new(random.unit(), random.unit(), random.unit()) * 4.0 - 2.0,
             forward: random.direction(),
-            cos_frustum: 0.5 + 0.45 * random.next(),
+            cos_frustum: 0.5 + 0.45 * random.unit(),
         };
-        let centre = Vec3::new(random.next(), random.next(), random.next()) * 8.0 - 4.0;
-        let half = Vec3::new(random.next(), random.next(), random.next()) * 1.5;
+        let centre = Vec3::new(random.unit(), random.unit(), random.unit()) * 8.0 - 4.0;
+        let half = Vec3::new(random.unit(), random.unit(), random.unit()) * 1.5;
         let bounds = Aabb {
             min: centre - half,
             max: centre + half,
@@ -1141,7 +1141,7 @@ fn a_lookup_reads_no_finer_level_than_its_cluster() {
         for _ in 0..20 {
             let p = bounds.min
                 + (bounds.max - bounds.min)
-                    * Vec3::new(random.next(), random.next(), random.next());
+                    * Vec3::new(random.unit(), random.unit(), random.unit());
             assert!(
                 camera.point_level(p, &distances) >= level,
                 "{camera:?}: a point of {bounds:?} reads level {} below its box's {level}",

@@ -96,7 +96,7 @@ pub struct VctArgs {
     pub no_accumulate: bool,
     /// Light bounces between voxels, 1 to 64 (1: direct light on the voxels only)
     /// [default: 8 for frames; for one image (`render`) as many as leave under 1 % of the
-    /// light untraced, from the surfaces' mean albedo].
+    /// light untraced, at the rate the camera's diffuse walks measure].
     #[arg(long)]
     pub bounces: Option<u32>,
     /// Shadow the direct light with soft-shadow cones through the voxels instead of with

@@ -6,6 +6,7 @@ use super::octree::Capacities;
 use super::voxelize::Voxelizer;
 use super::Grid;
 use crate::gpu_layout as layout;
+use crate::ray::host::bounce_rate;
 use crate::scene::Scene;
 use crate::vk::Context;
 
@@ -196,42 +197,43 @@ const BOUNCE_REMAINDER: f32 = 0.01;
 
 /// Voxel bounces ([`ConeSettings::bounces`]) for one image where none are given: the
 /// fewest that leave under [`BOUNCE_REMAINDER`] of the indirect light untraced where each
-/// bounce keeps `albedo` of the light (the scene's area-weighted mean,
-/// [`Scene::mean_albedo`], as in an integrating sphere). With `bounces` the image holds
-/// that many bounces of indirect light (the voxels one fewer, the screen's gather one
-/// more), and bounce k carries albedo^(k-1) of the first's light, so what is left is
-/// albedo^bounces of it all. The brightest material's albedo would bound it, but a small
-/// white object in a dark room then asks for dozens of bounces that carry nothing.
+/// bounce passes on `rate` of the light it received ([`bounce_rate`], measured along
+/// diffuse walks in the scene). With `bounces` the image holds that many bounces of
+/// indirect light (the voxels one fewer, the screen's gather one more), and bounce k
+/// carries rate^(k-1) of the first's light, so what is left is rate^bounces of it all.
 /// Frames need no more than their default: each adds a bounce to the last frame's light.
 /// One image at eight left the conference room's bounces after the first 5 % short of
-/// the path tracer's at 256³ (its albedo 0.7: 13 bounces; BENCHMARKS.md, session 44).
-pub fn converged_bounces(albedo: f32) -> u32 {
-    if albedo <= 0.0 {
+/// the path tracer's at 256³ (its rate about 0.7: 13 bounces; BENCHMARKS.md, session 44).
+pub fn converged_bounces(rate: f32) -> u32 {
+    if rate <= 0.0 {
         return 1;
     }
-    if albedo >= 1.0 {
+    if rate >= 1.0 {
         return MAX_BOUNCES;
     }
     // Finite and positive: both logarithms are negative.
-    (BOUNCE_REMAINDER.ln() / albedo.ln())
+    (BOUNCE_REMAINDER.ln() / rate.ln())
         .ceil()
         .clamp(1.0, MAX_BOUNCES as f32) as u32
 }
 
 /// [`converged_bounces`] for `scene`, logged with the reason.
 pub fn bounces_for(scene: &Scene) -> u32 {
-    let albedo = scene.mean_albedo();
-    let bounces = converged_bounces(albedo);
-    if albedo >= 1.0 {
+    let start = std::time::Instant::now();
+    let rate = bounce_rate(scene);
+    let bounces = converged_bounces(rate);
+    let seconds = start.elapsed().as_secs_f32();
+    if rate >= 1.0 {
         log::warn!(
-            "bounces: {bounces}, the most: the surfaces reflect all the light ({albedo:.3}), \
+            "bounces: {bounces}, the most: a bounce passes all the light on ({rate:.3}), \
              so no count of bounces leaves under {:.0} % of it untraced",
             BOUNCE_REMAINDER * 100.0
         );
     } else {
         log::info!(
             "bounces: {bounces} (one image: under {:.0} % of the indirect light left untraced \
-             where each bounce keeps the surfaces' mean albedo, {albedo:.3})",
+             where each bounce passes on {rate:.3} of its light, measured along the camera's \
+             diffuse walks in {seconds:.2} s)",
             BOUNCE_REMAINDER * 100.0
         );
     }
@@ -480,20 +482,17 @@ mod tests {
         );
     }
 
-    /// The fewest bounces whose untraced rest, albedo^bounces of the indirect light, is
-    /// under the remainder: one fewer would leave more; none where nothing
-    /// reflects, the most where everything does.
+    /// The fewest bounces whose untraced rest, rate^bounces of the indirect light, is
+    /// under the remainder: one fewer would leave more; one where nothing is passed on,
+    /// the most where everything is.
     #[test]
     fn converged_bounces_leave_under_the_remainder() {
         assert_eq!(converged_bounces(0.7), 13);
         assert_eq!(converged_bounces(0.78), 19);
-        for albedo in [0.05, 0.3, 0.5, 0.7, 0.8, 0.9] {
-            let bounces = converged_bounces(albedo);
-            assert!(albedo.powi(bounces as i32) < BOUNCE_REMAINDER, "{albedo}");
-            assert!(
-                albedo.powi(bounces as i32 - 1) >= BOUNCE_REMAINDER,
-                "{albedo}"
-            );
+        for rate in [0.05, 0.3, 0.5, 0.7, 0.8, 0.9] {
+            let bounces = converged_bounces(rate);
+            assert!(rate.powi(bounces as i32) < BOUNCE_REMAINDER, "{rate}");
+            assert!(rate.powi(bounces as i32 - 1) >= BOUNCE_REMAINDER, "{rate}");
         }
         assert_eq!(converged_bounces(0.0), 1);
         assert_eq!(converged_bounces(0.99), MAX_BOUNCES);
