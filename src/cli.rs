@@ -456,7 +456,10 @@ impl CommonArgs {
                         name.unwrap_or_default()
                     );
                 }
-                GiSettings::Probes(self.probes.frame_settings(scene)?)
+                GiSettings::Probes(
+                    self.probes
+                        .frame_settings(scene, quality == Quality::Accurate)?,
+                )
             }
             GiMode::Off => {
                 if self.debug_view != DebugView::None {
@@ -907,6 +910,31 @@ mod tests {
             &none
         ));
         assert!(!converge(&["voxcone", "view"], &none));
+    }
+
+    /// So do the irradiance probes' (`--probe-bounces`).
+    #[test]
+    fn one_image_converges_the_probes_bounces() {
+        let converge = |args: &[&str], scene: &GiOverrides| {
+            let args = [args, &["--gi", "probes"][..]].concat();
+            match settings_of(&args, scene).unwrap().gi {
+                GiSettings::Probes(probes) => probes.converge_bounces,
+                _ => panic!("no probes"),
+            }
+        };
+        let none = GiOverrides::default();
+        assert!(converge(&["voxcone", "render"], &none));
+        assert!(!converge(
+            &["voxcone", "render", "--probe-bounces", "8"],
+            &none
+        ));
+        let given = GiOverrides {
+            probe_bounces: Some(3),
+            ..Default::default()
+        };
+        assert!(!converge(&["voxcone", "render"], &given));
+        assert!(!converge(&["voxcone", "view"], &none));
+        assert!(!converge(&["voxcone", "bench"], &none));
     }
 
     /// `render` draws its shadow maps finer than the frames do, `--quality fast` as the

@@ -21,11 +21,12 @@ use glam::Vec3;
 use winit::window::Window;
 
 use crate::cli::{CommonArgs, GiMode};
+use crate::gi::bounces::MAX_BOUNCES;
 use crate::gi::path::cli::PathArgs;
 use crate::gi::probes::cli::{ProbeArgs, Switch};
 use crate::gi::vct::cli::VctArgs;
 use crate::gi::vct::voxelize::Voxelizer;
-use crate::gi::vct::{DirectionalFilter, Store, CPU_VOXELS, LATTICE_CONES, MAX_BOUNCES};
+use crate::gi::vct::{DirectionalFilter, Store, CPU_VOXELS, LATTICE_CONES};
 use crate::gi::{DebugView, GiSettings};
 use crate::renderer::{Renderer, FRAMES_IN_FLIGHT};
 use crate::scene::{Light, LightKind};

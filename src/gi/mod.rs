@@ -12,6 +12,7 @@
 //! lists what else it touches. Today: voxel cone tracing ([`vct`]), the path-traced
 //! reference ([`path`]) and irradiance probes ([`probes`]).
 
+pub mod bounces;
 pub mod path;
 pub mod probes;
 pub mod screen;
@@ -52,7 +53,7 @@ impl GiSettings {
                 voxels: vct::Resolution::Count(vct.voxels.on(ctx, scene, &vct.cones)),
                 cones: vct::ConeSettings {
                     bounces: if vct.converge_bounces {
-                        vct::bounces_for(scene)
+                        bounces::bounces_for(scene)
                     } else {
                         vct.cones.bounces
                     },
@@ -60,6 +61,15 @@ impl GiSettings {
                 },
                 converge_bounces: false,
                 ..*vct
+            }),
+            GiSettings::Probes(probes) => GiSettings::Probes(probes::frame::ProbeSettings {
+                bounces: if probes.converge_bounces {
+                    bounces::bounces_for(scene)
+                } else {
+                    probes.bounces
+                },
+                converge_bounces: false,
+                ..probes.clone()
             }),
             other => other.clone(),
         }

@@ -10,7 +10,7 @@ use super::host::bounce_rate;
 use super::query::RayQueries;
 use super::surfaces::check_buffer_size;
 use super::{SceneRays, Triangles};
-use crate::gi::vct::converged_bounces;
+use crate::gi::bounces::converged_bounces;
 use crate::gpu_layout::{RayHit, RayQuery, RAY_ANY, RAY_CLOSEST, RAY_NONE};
 use crate::scene::testing::{shared_file, TempDir};
 use crate::scene::{LoadOptions, Scene};

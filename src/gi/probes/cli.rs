@@ -59,7 +59,8 @@ pub struct ProbeArgs {
     pub bake_file: Option<PathBuf>,
     /// `--gi probes`: light bounces the first frame computes, 1 to 64 (1: no bounce
     /// between surfaces after the first; with more, every later frame adds one)
-    /// [default: 8].
+    /// [default: 8 for frames; for one image (`render`) as many as leave under 1 % of the
+    /// light untraced, at the rate the camera's diffuse walks measure].
     #[arg(long)]
     pub probe_bounces: Option<u32>,
     /// `--gi probes`: the dynamic level of detail by camera distance (Sedláček 2019, 4.2):
@@ -82,8 +83,10 @@ pub enum Switch {
 
 impl ProbeArgs {
     /// The frame's settings: the command line over the scene file's `[gi]` over the
-    /// defaults (checked by [`ProbeSettings::check`]).
-    pub fn frame_settings(&self, scene: &GiOverrides) -> Result<ProbeSettings> {
+    /// defaults (checked by [`ProbeSettings::check`]); `one_image`: a single render, which
+    /// without a given count traces its bounces until they converge.
+    pub fn frame_settings(&self, scene: &GiOverrides, one_image: bool) -> Result<ProbeSettings> {
+        let bounces = self.probe_bounces.or(scene.probe_bounces);
         let d = ProbeSettings::default();
         let distances = match self.lod_distances.as_deref() {
             Some(v) => Some(<[f32; 3]>::try_from(v).map_err(|_| {
@@ -97,10 +100,8 @@ impl ProbeArgs {
         let settings = ProbeSettings {
             bake: self.settings(scene)?,
             bake_file: self.bake_file.clone(),
-            bounces: self
-                .probe_bounces
-                .or(scene.probe_bounces)
-                .unwrap_or(d.bounces),
+            bounces: bounces.unwrap_or(d.bounces),
+            converge_bounces: one_image && bounces.is_none(),
             lod: self
                 .probe_lod
                 .map(|s| s == Switch::On)

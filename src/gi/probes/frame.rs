@@ -33,6 +33,7 @@ use super::grid::Grid;
 use super::levels::{LightmapLevels, Work, LEVELS};
 use super::sh::Basis;
 use super::{octahedral, BakeReport, BakeSettings, Origin};
+use crate::gi::bounces::MAX_BOUNCES;
 use crate::gi::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
     Switch, Technique,
@@ -59,6 +60,9 @@ pub struct ProbeSettings {
     /// than one, every later frame adds one more on top of the last frame's lightmap, so
     /// the bounces converge as a geometric series.
     pub bounces: u32,
+    /// One image without a given count: `bounces` becomes
+    /// [`crate::gi::bounces::bounces_for`] the scene ([`crate::gi::GiSettings::on`]).
+    pub converge_bounces: bool,
     /// The dynamic level of detail (4.2), and the camera distances where its levels 1 to 3
     /// begin (`None`: [`LOD_RADII`] probe radii).
     pub lod: bool,
@@ -71,6 +75,7 @@ impl Default for ProbeSettings {
             bake: BakeSettings::default(),
             bake_file: None,
             bounces: 8,
+            converge_bounces: false,
             lod: true,
             lod_distances: None,
         }
@@ -125,9 +130,6 @@ pub(super) const LIGHTMAP_USE: ImageUse = ImageUse {
             | vk::AccessFlags2::SHADER_SAMPLED_READ.as_raw(),
     ),
 };
-
-/// The most bounces a first frame computes.
-pub const MAX_BOUNCES: u32 = 64;
 
 /// The most workgroups of one dispatch along x that every device runs.
 const MAX_GROUPS: u32 = 65535;

@@ -657,6 +657,7 @@ fn twin_settings(dir: &TempDir, lod_distances: Option<[f32; 3]>) -> super::frame
         },
         bake_file: Some(dir.0.join("box.bake")),
         bounces: 1,
+        converge_bounces: false,
         lod: lod_distances.is_some(),
         lod_distances,
     }
@@ -975,6 +976,7 @@ fn the_level_of_detail_keeps_the_lightmap_near_the_camera() {
             bake,
             bake_file: Some(dir.0.join("box.bake")),
             bounces: 8,
+            converge_bounces: false,
             lod,
             lod_distances: Some(distances),
         };
@@ -1174,4 +1176,35 @@ fn a_lookup_reads_no_finer_level_than_its_cluster() {
         camera.box_level(&small(Vec3::new(1.5, 0.0, -0.2)), &distances),
         2
     );
+}
+
+/// One image without a given count of bounces takes the rule's for its scene (the built-in
+/// box: seven, not the frames' eight) when the renderer resolves its settings; a given
+/// count stays.
+#[test]
+fn converged_bounces_reach_the_probes() {
+    use super::frame::ProbeSettings;
+    use crate::gi::bounces::converged_bounces;
+    use crate::gi::GiSettings;
+    use crate::ray::host::bounce_rate;
+
+    let scene = Scene::load(&crate::cli::default_scene(), &LoadOptions::default()).unwrap();
+    let want = converged_bounces(bounce_rate(&scene));
+    assert_ne!(want, ProbeSettings::default().bounces);
+    let ctx = validating_context();
+    let resolved = |converge_bounces: bool| {
+        let settings = GiSettings::Probes(ProbeSettings {
+            converge_bounces,
+            ..Default::default()
+        });
+        match settings.on(&ctx, &scene) {
+            GiSettings::Probes(probes) => probes,
+            _ => panic!("no probes"),
+        }
+    };
+    let converged = resolved(true);
+    assert_eq!(converged.bounces, want);
+    assert!(!converged.converge_bounces);
+    assert_eq!(resolved(false).bounces, ProbeSettings::default().bounces);
+    assert_eq!(ctx.validation_messages(), 0);
 }

@@ -30,9 +30,9 @@ pub use self::dense::Dense;
 pub use self::grid::Grid;
 pub use self::octree::Octree;
 pub use self::settings::{
-    auto_indirect_scale, auto_voxels, bounces_for, check_voxel_size, check_voxels,
-    converged_bounces, ConeSettings, DirectionalFilter, Quality, Resolution, Store, VctSettings,
-    CPU_VOXELS, DEFAULT_SAMPLED_EMITTERS, LATTICE_CONES, MAX_BOUNCES, MOST_VOXELS,
+    auto_indirect_scale, auto_voxels, check_voxel_size, check_voxels, ConeSettings,
+    DirectionalFilter, Quality, Resolution, Store, VctSettings, CPU_VOXELS,
+    DEFAULT_SAMPLED_EMITTERS, LATTICE_CONES, MOST_VOXELS,
 };
 use super::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,

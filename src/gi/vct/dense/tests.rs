@@ -6,12 +6,14 @@ use std::sync::Arc;
 use super::super::reference;
 use super::super::voxelize::Voxelizer;
 use super::super::{
-    auto_voxels, converged_bounces, ConeSettings, DirectionalFilter, Grid, Quality, Resolution,
-    Store, CPU_VOXELS, LATTICE_CONES,
+    auto_voxels, ConeSettings, DirectionalFilter, Grid, Quality, Resolution, Store, CPU_VOXELS,
+    LATTICE_CONES,
 };
 use super::Volume;
+use crate::gi::bounces::converged_bounces;
 use crate::gi::GiSettings;
 use crate::gpu_layout as layout;
+use crate::ray::host::bounce_rate;
 use crate::renderer::Renderer;
 use crate::scene::testing::shared_file;
 use crate::scene::{LoadOptions, Scene};
@@ -447,7 +449,7 @@ fn voxel_list_holds_exactly_the_occupied_voxels() {
 #[test]
 fn converged_bounces_reach_the_renderer() {
     let scene = Scene::load(&crate::cli::default_scene(), &LoadOptions::default()).unwrap();
-    let want = converged_bounces(crate::ray::host::bounce_rate(&scene));
+    let want = converged_bounces(bounce_rate(&scene));
     assert_ne!(want, ConeSettings::default().bounces);
     let mut settings = gi_settings(CPU_VOXELS, DENSE, false);
     cone_settings(&mut settings).converge_bounces = true;
