@@ -618,7 +618,8 @@ fn bounces_over_the_first_match_the_path_tracer() {
 }
 
 /// One image traces its bounces until under 1 % of the indirect light is left
-/// (`converged_bounces`): in the conference room (a closed room, albedo 0.7: 13 bounces)
+/// (`converged_bounces`): in the conference room (a closed room of albedo 0.7, whose
+/// bounces the camera's walks find to fall by 0.699 each: 13 bounces)
 /// at 64³ the image's indirect light is within 1 % of 64 bounces'. Eight, the frames'
 /// count and one image's before, leave more than that untraced (there its bounces after
 /// the first fell 5 % short of the path tracer's at 256³; in the Cornell box, open at
