@@ -118,16 +118,15 @@ const STEPS: usize = 4;
 /// random point of its view, a square of its vertical field), on from each surface met in
 /// a cosine-distributed direction, each walk's weight in each channel the product of the
 /// albedos it met (each material's [`Scene::material_albedo`]); a walk that leaves the
-/// scene carries nothing after. Each channel falls at its own rate (a red wall keeps red
-/// light): the largest channel of each albedo would overstate them all where walls of
-/// different colours face each other. Its
-/// k-th step's weight is what the image's k-th bounce keeps where light reaches every
-/// surface alike. In a closed room of one albedo a the rate is a; it falls with the share
-/// of light that escapes (an open plane passes nothing on: it sees only the sky) and with
-/// the albedo of what the light meets (a white object in a black room passes almost
-/// nothing on). Walks start where the camera looks, so the insides of closed objects,
-/// which no light reaches, count for nothing. Every mesh counts at time 0, cut-outs as
-/// opaque.
+/// scene carries nothing after. A walk's k-th step's weight is what the image's k-th
+/// bounce keeps where light reaches every surface alike. Each channel falls at its own
+/// rate (a red wall keeps red light): the largest channel of each albedo would overstate
+/// them all where walls of different colours face each other. In a closed room of one
+/// albedo a the rate is a; it falls with the share of light that escapes (an open plane
+/// passes nothing on: it sees only the sky) and with the albedo of what the light meets
+/// (a white object in a black room passes almost nothing on). Walks start where the
+/// camera looks, so the insides of closed objects, which no light reaches, count for
+/// nothing. Every mesh counts at time 0, cut-outs as opaque.
 pub fn bounce_rate(scene: &Scene) -> f32 {
     let rays = HostRays::of(scene, |_| true);
     let albedos: Vec<Vec3> = (0..scene.materials.len())
@@ -144,8 +143,7 @@ pub fn bounce_rate(scene: &Scene) -> f32 {
     // triangle it leaves.
     let lift = 1e-5 * (high - low).length();
     let camera = &scene.camera;
-    let forward = (camera.target - camera.position).normalize();
-    let right = forward.cross(camera.up).normalize();
+    let (forward, right) = (camera.forward(), camera.right());
     let up = right.cross(forward);
     let half = (camera.fov_y_deg.to_radians() * 0.5).tan();
     let walk = |random: &mut Random, carried: &mut [DVec3; STEPS + 1]| {
