@@ -132,16 +132,9 @@ pub fn bounce_rate(scene: &Scene) -> f32 {
     let albedos: Vec<Vec3> = (0..scene.materials.len())
         .map(|m| scene.material_albedo(m as u32))
         .collect();
-    let (low, high) = rays
-        .corners
-        .iter()
-        .flatten()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(low, high), p| {
-            (low.min(*p), high.max(*p))
-        });
     // Off the surface by a little of the scene's size, so that a walk does not hit the
     // triangle it leaves.
-    let lift = 1e-5 * (high - low).length();
+    let lift = 1e-5 * scene.bounds(0.0).diagonal();
     let camera = &scene.camera;
     let (forward, right) = (camera.forward(), camera.right());
     let up = right.cross(forward);
@@ -175,6 +168,8 @@ pub fn bounce_rate(scene: &Scene) -> f32 {
             }
             carried
         })
+        // Summed in task order, not by rayon's reduce, whose grouping follows the work
+        // stealing: the same walks then give the same rate to the last bit.
         .collect::<Vec<_>>()
         .iter()
         .fold([DVec3::ZERO; STEPS + 1], |mut sum, c| {
