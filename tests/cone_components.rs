@@ -569,13 +569,14 @@ fn one_bounce_per_block_matches_the_path_tracer() {
 /// against the path tracer's `--max-depth 2` less its `--max-depth 1` (the emitter
 /// itself, antialiased alike). Where nothing shadows it, every block is within 2 % but
 /// four along the ceiling's edge, where the upsample lends the top row of the back
-/// wall's light to the unlit ceiling beside it (1.13 to 1.15); the shadows of the two
-/// blocks come out hard, as from the emitter's centre, where the reference's have
-/// penumbrae.
+/// wall's light to the unlit ceiling beside it (1.13 to 1.15). The emitter cut into
+/// eight pieces (`render`'s default) gives the two blocks' shadows penumbrae, but the
+/// blocks' voxels cast them too wide: the blocks off by 0.088 on average against one
+/// piece's 0.102 (at 128³: 0.072 and 0.087).
 #[test]
 #[cfg_attr(
     voxcone_shared,
-    ignore = "issue 20: 39 of the 54 blocks within 10 %: the blocks' shadows 0.31 to 0.90, the ceiling's edge 1.13 to 1.15"
+    ignore = "issue 20: 39 of the 54 blocks within 10 % (with one emitter piece too): the blocks' shadows 0.12 to 0.88 (too wide, as `block_shadow_is_as_wide_as_the_path_tracers` measures), the ceiling's edge 1.13 to 1.15"
 )]
 #[cfg_attr(not(voxcone_shared), ignore = "needs ../shared")]
 fn emitter_lights_the_room_as_the_path_tracer_does() {
@@ -949,14 +950,23 @@ fn wall_on_a_lit_floor_matches_the_path_tracer_filtered_by_rows() {
 /// down), with or without a black block 0.6 x 0.3 x 0.6 half-way between them, as a
 /// scene file in `dir`, seen from above.
 fn floor_under_emitter(dir: &Path, block: bool) -> PathBuf {
+    let name = format!("e_{block}");
+    let camera = "position = [0, 0.3, 0.001]\ntarget = [0, 0, 0]\nfov_y_deg = 10";
+    emitter_over_floor(dir, &name, block.then_some([0.35, 0.65]), camera)
+}
+
+/// The unit square emitter 1 above a white floor 6 x 6 and, where `block` gives its
+/// bottom and top, a black block 0.6 x 0.6 between them, as a scene `name` in `dir` seen
+/// from `camera` (the scene file's `[camera]` keys).
+fn emitter_over_floor(dir: &Path, name: &str, block: Option<[f64; 2]>, camera: &str) -> PathBuf {
     let mut obj = String::from(
         "mtllib e.mtl\nv -3 0 3\nv 3 0 3\nv 3 0 -3\nv -3 0 -3\n\
          v -0.5 1 -0.5\nv 0.5 1 -0.5\nv 0.5 1 0.5\nv -0.5 1 0.5\n\
          usemtl floor\nf 1 2 3 4\nusemtl emit\nf 5 6 7 8\n",
     );
-    if block {
-        // Its six faces, from vertices 9 (y = 0.35) to 16 (y = 0.65).
-        for y in [0.35, 0.65] {
+    if let Some(heights) = block {
+        // Its six faces, from vertices 9 (the bottom) to 16 (the top).
+        for y in heights {
             for (x, z) in [(-0.3, -0.3), (0.3, -0.3), (0.3, 0.3), (-0.3, 0.3)] {
                 obj += &format!("v {x} {y} {z}\n");
             }
@@ -969,15 +979,11 @@ fn floor_under_emitter(dir: &Path, block: bool) -> PathBuf {
         "e.mtl",
         "newmtl floor\nKd 1 1 1\nnewmtl emit\nKd 0 0 0\nKe 1 1 1\nnewmtl black\nKd 0 0 0\n",
     );
-    let name = format!("e_{block}.obj");
-    write(dir, &name, &obj);
+    write(dir, &format!("{name}.obj"), &obj);
     write(
         dir,
-        &format!("e_{block}.toml"),
-        &format!(
-            "[camera]\nposition = [0, 0.3, 0.001]\ntarget = [0, 0, 0]\nfov_y_deg = 10\n\
-             [[mesh]]\npath = {name:?}\n"
-        ),
+        &format!("{name}.toml"),
+        &format!("[camera]\n{camera}\n[[mesh]]\npath = \"{name}.obj\"\n"),
     )
 }
 
@@ -1035,6 +1041,73 @@ fn floor_under_an_emitter_takes_its_irradiance_and_shadow() {
             shares[1]
         );
     }
+}
+
+/// The floor of `floor_under_emitter` with the black block lower (y 0.5 to 0.7), seen
+/// from under it with a 120 degree view: the block's umbra and all of its penumbra.
+fn floor_in_a_penumbra(dir: &Path) -> PathBuf {
+    let camera = "position = [0, 0.45, 0.001]\ntarget = [0, 0, 0]\nfov_y_deg = 120";
+    emitter_over_floor(dir, "penumbra", Some([0.5, 0.7]), camera)
+}
+
+/// The sampled emitter's light (`--debug-view emitter-light`) on a floor in a block's
+/// penumbra, summed over the view, as a share of the path tracer's (`--max-depth 2` less
+/// `--max-depth 1`), with `pieces` emitter pieces at 128³.
+fn penumbra_share(name: &str, pieces: &[u32]) -> Vec<f64> {
+    let dir = temp_dir(name);
+    let scene = floor_in_a_penumbra(&dir);
+    let path = |f: &str| dir.join(f);
+    for depth in ["1", "2"] {
+        render_path(
+            &scene,
+            &["--size", "256x256", "--spp", "64", "--max-depth", depth],
+            &path(&format!("path_{depth}.exr")),
+        );
+    }
+    let exact: f64 = block_indirect(&path("path_2.exr"), &path("path_1.exr"))
+        .iter()
+        .sum();
+    pieces
+        .iter()
+        .map(|n| {
+            let out = path(&format!("pieces_{n}.exr"));
+            let n = n.to_string();
+            let args = ["--debug-view", "emitter-light", "--bounces", "1"];
+            dense(
+                &scene,
+                128,
+                &[&args[..], &["--emitter-pieces", &n]].concat(),
+                &out,
+            );
+            let ours: f64 = block_sums(&load_rgb(&out).unwrap().0).iter().sum();
+            eprintln!(
+                "penumbra, {n} emitter pieces, 128³: {:.4} of the path tracer's light",
+                ours / exact
+            );
+            ours / exact
+        })
+        .collect()
+}
+
+/// An area emitter casts penumbrae: one visibility cone for the whole emitter shadows
+/// the floor as from its centre, the whole view dark (0.24 of the path tracer's light
+/// at 128³), and `render`'s eight pieces, each with its own cone, light the penumbra
+/// (0.785). What they leave is `block_shadow_is_as_wide_as_the_path_tracers`.
+#[test]
+fn emitter_pieces_cast_penumbrae() {
+    let shares = penumbra_share("components_penumbra", &[1, 8]);
+    assert!(shares[0] < 0.3, "one piece: {}", shares[0]);
+    assert!(shares[1] > 0.75, "eight pieces: {}", shares[1]);
+}
+
+/// The penumbra's light within 5 % of the path tracer's: the block's voxels cast a
+/// shadow 1.4 voxels wider than the block's (its umbra's edge 21 pixels out at 128³),
+/// however many pieces the emitter is cut into (4 to 256: 0.778 to 0.790).
+#[test]
+#[ignore = "issue 20: 0.785 of the path tracer's light with eight pieces at 128³"]
+fn block_shadow_is_as_wide_as_the_path_tracers() {
+    let share = penumbra_share("components_penumbra_width", &[8])[0];
+    assert!((share - 1.0).abs() <= 0.05, "{share}");
 }
 
 /// A table under a black sky, lit from straight above by a directional light of

@@ -66,6 +66,7 @@
 //! shadow_aperture_deg = 4.0      # --shadow-aperture
 //! ao_distance_voxels = 4.0       # --ao-distance
 //! sampled_emitters = 64          # --sampled-emitters
+//! emitter_pieces = 8             # --emitter-pieces (default: 8 where quality is accurate, else 1)
 //! spp = 256                      # --spp (--gi path)
 //! max_depth = 2                  # --max-depth (--gi path): 2 is direct light only
 //! lightmap_size = 512            # --lightmap-size (--gi probes and bake)

@@ -217,6 +217,7 @@ pub struct GiOverrides {
     pub shadow_aperture_deg: Option<f32>,
     pub ao_distance_voxels: Option<f32>,
     pub sampled_emitters: Option<u32>,
+    pub emitter_pieces: Option<u32>,
     /// The path tracer's samples per pixel.
     pub spp: Option<u32>,
     /// The path tracer's longest path (a reference's `flags.max_depth`, where it has one).

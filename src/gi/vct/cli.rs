@@ -7,7 +7,7 @@ use super::octree::check_depth;
 use super::voxelize::Voxelizer;
 use super::{
     check_voxel_size, check_voxels, ConeSettings, DirectionalFilter, Quality, Resolution, Store,
-    VctSettings, DEFAULT_SAMPLED_EMITTERS, LATTICE_CONES,
+    VctSettings, DEFAULT_SAMPLED_EMITTERS, EMITTER_PIECES, LATTICE_CONES,
 };
 use crate::scene::GiOverrides;
 
@@ -122,6 +122,12 @@ pub struct VctArgs {
     /// emitter's with 0, is gathered through the voxels [default: 64].
     #[arg(long)]
     pub sampled_emitters: Option<u32>,
+    /// The pieces the sampled emitters are cut into, 1 to 256, each with its own
+    /// soft-shadow cone, so that an emitter's shadows have penumbrae: the longest piece is
+    /// halved until there are this many or none is longer than a voxel [default: 8 where
+    /// --quality is accurate, else 1]
+    #[arg(long)]
+    pub emitter_pieces: Option<u32>,
     /// How the scene is voxelized (both cover the same voxels)
     #[arg(long, value_enum, default_value_t)]
     pub voxelizer: Voxelizer,
@@ -166,6 +172,7 @@ impl VctArgs {
                 "--directional-filter",
             ),
             (self.sampled_emitters.is_some(), "--sampled-emitters"),
+            (self.emitter_pieces.is_some(), "--emitter-pieces"),
             (self.no_plane_occlusion, "--no-plane-occlusion"),
         ]
         .into_iter()
@@ -357,6 +364,18 @@ impl VctArgs {
         if sampled_emitters > 1024 {
             bail!("--sampled-emitters / sampled_emitters must be at most 1024, got {sampled_emitters}");
         }
+        let emitter_pieces =
+            self.emitter_pieces
+                .or(scene.emitter_pieces)
+                .unwrap_or(match quality {
+                    Quality::Accurate => EMITTER_PIECES,
+                    Quality::Fast => 1,
+                });
+        if !(1..=256).contains(&emitter_pieces) {
+            bail!(
+                "--emitter-pieces / emitter_pieces must be between 1 and 256, got {emitter_pieces}"
+            );
+        }
         Ok(VctSettings {
             voxels,
             store,
@@ -367,6 +386,7 @@ impl VctArgs {
             full_update: self.full_update,
             voxelizer: self.voxelizer,
             sampled_emitters,
+            emitter_pieces,
         })
     }
 }

@@ -16,6 +16,14 @@
 //! `VctSettings::sampled_emitters` such triangles (each costs every shaded point an
 //! irradiance evaluation). Others stay in the voxels and reach the surfaces through the
 //! gather, as all emitters do with `--sampled-emitters 0`.
+//!
+//! One cone stands for the visibility of the whole piece, along its vector irradiance: a
+//! hard shadow, as from the piece's centre, where an area emitter casts penumbrae (a
+//! floor under a block lit by a square emitter took 0.24 of the path tracer's light in
+//! view, the whole penumbra dark). So the pieces are cut, the longest first, into up to
+//! `VctSettings::emitter_pieces` parts of at least a voxel, each an emitter with its own
+//! cone: the shadow becomes the mean of the parts' (0.79 with 8), and the parts'
+//! irradiances still sum to the piece's exactly.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -78,8 +86,14 @@ fn constant_emitter(m: &Material) -> bool {
 }
 
 /// The emitters of `scene` to sample, when it has at most `max_triangles` triangles of
-/// them; none otherwise (and with `max_triangles` 0).
-pub fn sampled_emitters(scene: &Scene, max_triangles: u32) -> SampledEmitters {
+/// them (none otherwise, and with `max_triangles` 0), cut into up to `parts` emitters no
+/// shorter than `smallest` (a voxel).
+pub fn sampled_emitters(
+    scene: &Scene,
+    max_triangles: u32,
+    parts: usize,
+    smallest: f32,
+) -> SampledEmitters {
     let words = scene.materials.len().div_ceil(32).max(1);
     let mut out = SampledEmitters {
         material_bits: vec![0; words],
@@ -112,6 +126,7 @@ pub fn sampled_emitters(scene: &Scene, max_triangles: u32) -> SampledEmitters {
         d if d > 0.0 => d,
         _ => 1.0,
     };
+    let mut pieces = Vec::new();
     for mesh in meshes {
         let m = mesh.material as usize;
         out.material_bits[m / 32] |= 1 << (m % 32);
@@ -127,30 +142,135 @@ pub fn sampled_emitters(scene: &Scene, max_triangles: u32) -> SampledEmitters {
             .filter(|t| (t[1] - t[0]).cross(t[2] - t[0]).length_squared() > 0.0)
             .collect();
         for group in planar_pieces(&triangles, extent) {
-            let normal = group.normal;
-            out.emitters.push(VctEmitter {
-                plane: normal
-                    .extend(normal.dot(triangles[group.members[0]][0]))
-                    .to_array(),
-                radiance: scene.materials[m].emission.extend(0.0).to_array(),
-                first_triangle: out.triangles.len() as u32,
-                triangle_count: group.members.len() as u32,
-                ..Default::default()
+            pieces.push(Part {
+                material: m,
+                normal: group.normal,
+                triangles: group.members.iter().map(|&i| triangles[i]).collect(),
             });
-            out.triangles
-                .extend(group.members.iter().map(|&i| VctEmitterTriangle {
-                    v0: triangles[i][0].extend(0.0).to_array(),
-                    v1: triangles[i][1].extend(0.0).to_array(),
-                    v2: triangles[i][2].extend(0.0).to_array(),
-                }));
         }
     }
+    let whole = pieces.len();
+    cut(&mut pieces, parts, smallest);
+    for part in &pieces {
+        let normal = part.normal;
+        out.emitters.push(VctEmitter {
+            plane: normal.extend(normal.dot(part.triangles[0][0])).to_array(),
+            radiance: scene.materials[part.material]
+                .emission
+                .extend(0.0)
+                .to_array(),
+            first_triangle: out.triangles.len() as u32,
+            triangle_count: part.triangles.len() as u32,
+            ..Default::default()
+        });
+        out.triangles
+            .extend(part.triangles.iter().map(|t| VctEmitterTriangle {
+                v0: t[0].extend(0.0).to_array(),
+                v1: t[1].extend(0.0).to_array(),
+                v2: t[2].extend(0.0).to_array(),
+            }));
+    }
     log::info!(
-        "the cone tracer samples the emitters' light instead of gathering it: {} planar \
-         pieces, {count} triangles",
+        "the cone tracer samples the emitters' light instead of gathering it: {whole} planar \
+         pieces of {count} triangles, cut into {} emitters",
         out.emitters.len()
     );
     out
+}
+
+/// A sampled emitter: triangles of one material in one plane.
+struct Part {
+    material: usize,
+    normal: Vec3,
+    triangles: Vec<[Vec3; 3]>,
+}
+
+/// The parts cut in halves, the longest first, across the longest side of their bounds
+/// (so that a rectangle becomes a grid of near-square cells), until there are `parts` or
+/// none is longer than `smallest`.
+fn cut(pieces: &mut Vec<Part>, parts: usize, smallest: f32) {
+    let longest = |t: &[[Vec3; 3]]| {
+        let (lo, hi) = t.iter().flatten().fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let size = hi - lo;
+        let axis = (0..3).fold(0, |best, k| if size[k] > size[best] { k } else { best });
+        (size[axis], axis, 0.5 * (lo[axis] + hi[axis]))
+    };
+    while pieces.len() < parts {
+        let Some((i, (size, axis, middle))) = pieces
+            .iter()
+            .map(|p| longest(&p.triangles))
+            .enumerate()
+            .max_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
+        else {
+            return;
+        };
+        if size <= smallest {
+            return;
+        }
+        let (mut below, mut above) = (Vec::new(), Vec::new());
+        for t in &pieces[i].triangles {
+            clip_triangle(*t, axis, middle, &mut below, &mut above);
+        }
+        below.retain(|t| area(t) > 0.0);
+        above.retain(|t| area(t) > 0.0);
+        if below.is_empty() || above.is_empty() {
+            return;
+        }
+        let (material, normal) = (pieces[i].material, pieces[i].normal);
+        pieces[i].triangles = below;
+        pieces.push(Part {
+            material,
+            normal,
+            triangles: above,
+        });
+    }
+}
+
+/// A cut through a corner leaves a triangle of no area, which no emitter needs.
+fn area(t: &[Vec3; 3]) -> f32 {
+    0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
+}
+
+/// Triangle `t` cut by the plane where coordinate `axis` is `at`: its parts below go to
+/// `below`, those above to `above` (a triangle and a quad's two triangles where it
+/// crosses), each keeping `t`'s winding.
+fn clip_triangle(
+    t: [Vec3; 3],
+    axis: usize,
+    at: f32,
+    below: &mut Vec<[Vec3; 3]>,
+    above: &mut Vec<[Vec3; 3]>,
+) {
+    let side = t.map(|p| p[axis] - at);
+    if side.iter().all(|&s| s <= 0.0) {
+        below.push(t);
+        return;
+    }
+    if side.iter().all(|&s| s >= 0.0) {
+        above.push(t);
+        return;
+    }
+    // The corner alone on its side, and the other two in the triangle's order after it.
+    let alone = (0..3)
+        .find(|&k| {
+            (side[k] > 0.0) != (side[(k + 1) % 3] > 0.0)
+                && (side[k] > 0.0) != (side[(k + 2) % 3] > 0.0)
+        })
+        .unwrap_or(0);
+    let (a, b, c) = (alone, (alone + 1) % 3, (alone + 2) % 3);
+    let crossing = |p: usize, q: usize| t[p] + (t[q] - t[p]) * (side[p] / (side[p] - side[q]));
+    let (ab, ca) = (crossing(a, b), crossing(c, a));
+    let (one, two) = if side[a] > 0.0 {
+        (above, below)
+    } else {
+        (below, above)
+    };
+    one.push([t[a], ab, ca]);
+    two.push([ab, t[b], t[c]]);
+    two.push([ab, t[c], ca]);
 }
 
 /// A connected set of coplanar triangles.
@@ -242,5 +362,45 @@ mod tests {
             [Vec3::ZERO, Vec3::Y, Vec3::X],
         ];
         assert_eq!(planar_pieces(&folded, 10.0).len(), 2);
+    }
+
+    /// A 2 x 1 rectangle cut into eight is a grid of 0.5 x 0.5 cells, their areas summing
+    /// to its own and their triangles keeping its winding; no cell is cut below
+    /// `smallest`.
+    #[test]
+    fn a_rectangle_is_cut_into_square_cells() {
+        let [a, b, c, d] = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(2.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        let rectangle = || {
+            vec![Part {
+                material: 0,
+                normal: Vec3::Z,
+                triangles: vec![[a, b, c], [a, c, d]],
+            }]
+        };
+        for (parts, smallest, count, side) in [(8, 0.01, 8, 0.5), (64, 0.3, 32, 0.25)] {
+            let mut pieces = rectangle();
+            cut(&mut pieces, parts, smallest);
+            assert_eq!(pieces.len(), count);
+            let mut total = 0.0;
+            for part in &pieces {
+                let area: f32 = part.triangles.iter().map(area).sum();
+                assert!((area - side * side).abs() < 1e-5, "{area}");
+                total += area;
+                let (lo, hi) = part.triangles.iter().flatten().fold(
+                    (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+                    |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+                );
+                assert!(((hi - lo) - Vec3::new(side, side, 0.0)).abs().max_element() < 1e-5);
+                for t in &part.triangles {
+                    assert!((t[1] - t[0]).cross(t[2] - t[0]).z > 0.0, "{t:?}");
+                }
+            }
+            assert!((total - 2.0).abs() < 1e-5);
+        }
     }
 }

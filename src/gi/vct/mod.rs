@@ -32,7 +32,7 @@ pub use self::octree::Octree;
 pub use self::settings::{
     auto_indirect_scale, auto_voxels, check_voxel_size, check_voxels, ConeSettings,
     DirectionalFilter, Quality, Resolution, Store, VctSettings, CPU_VOXELS,
-    DEFAULT_SAMPLED_EMITTERS, LATTICE_CONES, MOST_VOXELS,
+    DEFAULT_SAMPLED_EMITTERS, EMITTER_PIECES, LATTICE_CONES, MOST_VOXELS,
 };
 use super::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
@@ -383,7 +383,12 @@ impl<S: VoxelStore> ConeTracing<S> {
             linear.raw,
             frames_in_flight,
         )?;
-        let sampled = emitters::sampled_emitters(scene, settings.sampled_emitters);
+        let sampled = emitters::sampled_emitters(
+            scene,
+            settings.sampled_emitters,
+            settings.emitter_pieces as usize,
+            grid.voxel_size,
+        );
         let uniforms = VctUniforms {
             origin: grid.origin.extend(grid.voxel_size).to_array(),
             resolution,

@@ -215,7 +215,21 @@ pub struct VctSettings {
     /// The most emissive triangles whose light is sampled rather than gathered through the
     /// voxels (`emitters`); 0 gathers every emitter's.
     pub sampled_emitters: u32,
+    /// The pieces the sampled emitters are cut into, each with its own visibility cone
+    /// (`emitters::sampled_emitters`).
+    pub emitter_pieces: u32,
 }
+
+/// `VctSettings::emitter_pieces` for one image ([`Quality::Accurate`]) unless the command
+/// line or the scene file says otherwise. On a floor under a block lit by a square
+/// emitter, at 128³, the light in view is 0.24 of the path tracer's with one piece and
+/// 0.79 with four to 256 (the rest is the block's voxels, whose shadow is 1.4 voxels too
+/// wide); more pieces spread it better over the penumbra (32x32 blocks off by 0.38, 0.33
+/// and 0.29 on average with 4, 8 and 16). Eight, not sixteen: the first cone_trace
+/// dispatch traces every piece's cone, and with sixteen the octree's descents ran past
+/// llvmpipe's 65,535 loop iterations an invocation on `cornell_area` (BENCHMARKS.md,
+/// session 46). Frames keep one: each piece costs every traced point a cone.
+pub const EMITTER_PIECES: u32 = 8;
 
 /// `VctSettings::sampled_emitters` unless the command line or the scene file says otherwise.
 pub const DEFAULT_SAMPLED_EMITTERS: u32 = 64;
@@ -232,6 +246,7 @@ impl VctSettings {
             full_update: false,
             voxelizer: Voxelizer::default(),
             sampled_emitters: DEFAULT_SAMPLED_EMITTERS,
+            emitter_pieces: 1,
         }
     }
 }
