@@ -894,14 +894,14 @@ gpu_layout! {
 
     /// Push constants of cone tracing: the lattice cones (`--lattice-cones`) this dispatch traces; the first dispatch also traces every other cone of the pass.
     struct ConeTracePush {
-        /// The first lattice cone of this dispatch: 0 starts the gather afresh, later dispatches add to what the ones before left in `BINDING_SCREEN_INDIRECT`.
+        /// The first lattice cone of this dispatch. The first dispatch (first cone 0, no emitters) starts the gather afresh; later dispatches add to what the ones before left in `BINDING_SCREEN_INDIRECT`.
         uint first_cone,
         /// Lattice cones this dispatch traces.
         uint cone_count,
-        /// Unused.
-        uint pad0,
-        /// Unused.
-        uint pad1,
+        /// The first sampled emitter whose light this dispatch adds.
+        uint first_emitter,
+        /// Sampled emitters whose light this dispatch adds (each with its visibility cone).
+        uint emitter_count,
     }
 
     /// Push constants of the path tracer: this dispatch's share of the samples.

@@ -23,18 +23,31 @@ use crate::vk::{compute_to_compute, groups_2d, Context, Pipeline};
 /// session 36). A GPU has no such limit and pays only the few extra reads of the
 /// G-buffer.
 const LATTICE_CONES_PER_DISPATCH: u32 = 24;
+/// The most sampled emitters whose light one dispatch adds, after the lattice's: each
+/// emitter's visibility cone marches through the voxels as a lattice cone does, and
+/// sixteen of them beside the lattice's first share ran past llvmpipe's loop budget in
+/// the octree at depth 7 (`cornell_area` cut into sixteen pieces: LDR-FLIP 0.112 against
+/// the dense grid's 0.059; BENCHMARKS.md, session 46).
+const EMITTERS_PER_DISPATCH: u32 = 8;
 
 pub struct ConeTracePass {
     ctx: Arc<Context>,
     /// Without and with ambient occlusion.
     trace: [Pipeline; 2],
-    /// The dispatches' shares of the lattice (one, of no cones, without it).
+    /// The dispatches' shares of the lattice (one, of no cones, without it), then of the
+    /// sampled emitters.
     shares: Vec<ConeTracePush>,
 }
 
 impl ConeTracePass {
-    /// `base` makes the pipelines; `shaders` are the store's variants.
-    pub fn new(ctx: &Arc<Context>, base: PipelineBase, shaders: &StoreShaders) -> Result<Self> {
+    /// `base` makes the pipelines; `shaders` are the store's variants; `emitters` is the
+    /// count of sampled emitters.
+    pub fn new(
+        ctx: &Arc<Context>,
+        base: PipelineBase,
+        shaders: &StoreShaders,
+        emitters: u32,
+    ) -> Result<Self> {
         let push = std::mem::size_of::<ConeTracePush>() as u32;
         let trace = [
             base.compute(ctx, "cone_trace", shaders.cone_trace, push)?,
@@ -43,7 +56,7 @@ impl ConeTracePass {
         Ok(Self {
             ctx: ctx.clone(),
             trace,
-            shares: shares(base.lattice_cones()),
+            shares: shares(base.lattice_cones(), emitters),
         })
     }
 
@@ -71,39 +84,58 @@ impl ConeTracePass {
 }
 
 /// `lattice` cones (0: none) shared out over dispatches of at most
-/// LATTICE_CONES_PER_DISPATCH, as evenly as they go.
-fn shares(lattice: u32) -> Vec<ConeTracePush> {
-    let count = lattice.div_ceil(LATTICE_CONES_PER_DISPATCH).max(1);
-    (0..count)
-        .map(|i| ConeTracePush {
-            first_cone: lattice * i / count,
-            cone_count: lattice * (i + 1) / count - lattice * i / count,
-            ..Default::default()
-        })
-        .collect()
+/// LATTICE_CONES_PER_DISPATCH, as evenly as they go, then `emitters` over dispatches of
+/// at most EMITTERS_PER_DISPATCH.
+fn shares(lattice: u32, emitters: u32) -> Vec<ConeTracePush> {
+    let cones = lattice.div_ceil(LATTICE_CONES_PER_DISPATCH).max(1);
+    let lights = emitters.div_ceil(EMITTERS_PER_DISPATCH);
+    let cone_shares = (0..cones).map(|i| ConeTracePush {
+        first_cone: lattice * i / cones,
+        cone_count: lattice * (i + 1) / cones - lattice * i / cones,
+        ..Default::default()
+    });
+    let emitter_shares = (0..lights).map(|i| ConeTracePush {
+        first_emitter: emitters * i / lights,
+        emitter_count: emitters * (i + 1) / lights - emitters * i / lights,
+        ..Default::default()
+    });
+    cone_shares.chain(emitter_shares).collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// Every lattice cone is traced once, no dispatch takes more than its share, and
-    /// without the lattice there is one dispatch.
+    /// Every lattice cone and every emitter is traced once, no dispatch takes more than
+    /// its share or both kinds, only the first starts afresh (first cone 0, no
+    /// emitters), and without the lattice and emitters there is one dispatch.
     #[test]
-    fn the_lattice_is_shared_out_whole() {
+    fn the_lattice_and_the_emitters_are_shared_out_whole() {
         for lattice in [0, 32, 48, 72, 73, 96, 256] {
-            let shares = shares(lattice);
-            let mut next = 0;
-            for share in &shares {
-                assert_eq!(share.first_cone, next);
-                assert!(share.cone_count <= LATTICE_CONES_PER_DISPATCH);
-                next += share.cone_count;
+            for emitters in [0, 1, 8, 9, 64] {
+                let shares = shares(lattice, emitters);
+                let (mut cone, mut emitter) = (0, 0);
+                for (i, share) in shares.iter().enumerate() {
+                    assert_eq!(
+                        share.first_cone,
+                        if share.emitter_count > 0 { 0 } else { cone }
+                    );
+                    assert_eq!(share.first_emitter, emitter);
+                    assert!(share.cone_count <= LATTICE_CONES_PER_DISPATCH);
+                    assert!(share.emitter_count <= EMITTERS_PER_DISPATCH);
+                    assert!(share.cone_count == 0 || share.emitter_count == 0);
+                    let fresh = share.first_cone == 0 && share.emitter_count == 0;
+                    assert_eq!(fresh, i == 0);
+                    cone += share.cone_count;
+                    emitter += share.emitter_count;
+                }
+                assert_eq!((cone, emitter), (lattice, emitters));
+                assert_eq!(
+                    shares.len() as u32,
+                    lattice.div_ceil(LATTICE_CONES_PER_DISPATCH).max(1)
+                        + emitters.div_ceil(EMITTERS_PER_DISPATCH)
+                );
             }
-            assert_eq!(next, lattice);
-            assert_eq!(
-                shares.len(),
-                lattice.div_ceil(LATTICE_CONES_PER_DISPATCH).max(1) as usize
-            );
         }
     }
 }

@@ -449,7 +449,12 @@ impl<S: VoxelStore> ConeTracing<S> {
             lighting: None,
             shadow_cones: settings.shadow_cones,
             indirect_scale: cones.indirect_scale,
-            cone_trace: cone_trace::ConeTracePass::new(ctx, base, &S::SHADERS)?,
+            cone_trace: cone_trace::ConeTracePass::new(
+                ctx,
+                base,
+                &S::SHADERS,
+                sampled.emitters.len() as u32,
+            )?,
             voxel_view: debug::VoxelViewPass::new(ctx, base, &S::SHADERS)?,
             set,
             _sets: sets,

@@ -225,10 +225,10 @@ pub struct VctSettings {
 /// emitter, at 128³, the light in view is 0.24 of the path tracer's with one piece and
 /// 0.79 with four to 256 (the rest is the block's voxels, whose shadow is 1.4 voxels too
 /// wide); more pieces spread it better over the penumbra (32x32 blocks off by 0.38, 0.33
-/// and 0.29 on average with 4, 8 and 16). Eight, not sixteen: the first cone_trace
-/// dispatch traces every piece's cone, and with sixteen the octree's descents ran past
-/// llvmpipe's 65,535 loop iterations an invocation on `cornell_area` (BENCHMARKS.md,
-/// session 46). Frames keep one: each piece costs every traced point a cone.
+/// and 0.29 on average with 4, 8 and 16). Eight: sixteen spread it a little better for
+/// twice the cones, and `cornell_area`'s emitter light per block barely moves (off by
+/// 0.087 with one piece, 0.072 with eight, 0.070 with sixteen; BENCHMARKS.md, session
+/// 46). Frames keep one: each piece costs every traced point a cone.
 pub const EMITTER_PIECES: u32 = 8;
 
 /// `VctSettings::sampled_emitters` unless the command line or the scene file says otherwise.

@@ -19,17 +19,17 @@
 layout(local_size_x = SCREEN_GROUP_SIZE, local_size_y = SCREEN_GROUP_SIZE) in;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_INDIRECT, rgba16f) uniform image2D indirect;
 layout(set = SET_SCREEN, binding = BINDING_SCREEN_SHADOW, rgba16f) uniform writeonly image2D shadow;
-layout(set = SET_SCREEN, binding = BINDING_SCREEN_SPECULAR, rgba16f) uniform writeonly image2D specular;
-layout(set = SET_SCREEN, binding = BINDING_SCREEN_TRANSMITTED, rgba16f) uniform writeonly image2D transmitted;
+layout(set = SET_SCREEN, binding = BINDING_SCREEN_SPECULAR, rgba16f) uniform image2D specular;
+layout(set = SET_SCREEN, binding = BINDING_SCREEN_TRANSMITTED, rgba16f) uniform image2D transmitted;
 layout(push_constant) uniform Push {
     ConeTracePush push;
 };
 
-// Irradiance at the surface point p (normal n) from the sampled emitters, each shadowed by
-// a soft-shadow cone from `origin` along its phi.
-vec3 sampled_emitter_light(vec3 p, vec3 origin, vec3 n) {
+// Irradiance at the surface point p (normal n) from `count` sampled emitters from `first`,
+// each shadowed by a soft-shadow cone from `origin` along its phi.
+vec3 sampled_emitter_light(vec3 p, vec3 origin, vec3 n, uint first, uint count) {
     vec3 e = vec3(0.0);
-    for (uint i = 0u; i < vct.emitter_count; i++) {
+    for (uint i = first; i < first + count; i++) {
         VctEmitter emitter = vct_emitters[i];
         vec3 phi = emitter_phi(emitter, p, n);
         float cosine = dot(n, phi);
@@ -53,17 +53,18 @@ float disc_overlap(float a, float b, float d) {
          + b * b * acos(clamp((d * d + b * b - a * a) / (2.0 * d * b), -1.0, 1.0)) - 0.5 * lens;
 }
 
-// The sampled emitters' radiance averaged over the cone from `origin` along `dir` of
+// The radiance of `count` sampled emitters from `first` averaged over the cone from
+// `origin` along `dir` of
 // half-angle atan(tan_half) (a specular or refraction cone leaving the surface at p on
 // its `side`): the voxels the cone marches do not hold it. Each emitter covers the share
 // of the cone that a disc of its solid angle |phi| about phi's direction (phi over the
 // hemisphere about dir) covers of the cone's disc, both taken flat across dir (exact in
 // the limits of an emitter filling the cone or missing it); times its visibility along
 // the cone.
-vec3 sampled_emitter_radiance(vec3 p, vec3 origin, vec3 side, vec3 dir, float tan_half) {
+vec3 sampled_emitter_radiance(vec3 p, vec3 origin, vec3 side, vec3 dir, float tan_half, uint first, uint count) {
     float cone = atan(tan_half);
     vec3 radiance = vec3(0.0);
-    for (uint i = 0u; i < vct.emitter_count; i++) {
+    for (uint i = first; i < first + count; i++) {
         VctEmitter emitter = vct_emitters[i];
         vec3 phi = emitter_phi(emitter, p, dir);
         float solid = length(phi);
@@ -106,12 +107,13 @@ void main() {
 #endif
     vec3 start = p + n * (2.0 * vct.origin.w);
     bool emitters_alone = frame.debug_view == DEBUG_EMITTER_LIGHT;
-    // A later share of the lattice (cone_trace.rs says why it is split) adds to the
-    // earlier ones', its occlusion taken from alpha (the ambient occlusion). One call
-    // site per kind of gather: each is inlined.
-    bool later_share = LATTICE_CONES > 0u && push.first_cone > 0u;
+    // A later dispatch, a share of the lattice or of the sampled emitters (cone_trace.rs
+    // says why they are split), adds to the earlier ones', the lattice's occlusion taken
+    // from alpha (the ambient occlusion). One call site per kind of gather: each is
+    // inlined.
+    bool later_share = push.first_cone > 0u || push.emitter_count > 0u;
     vec4 gathered = later_share ? imageLoad(indirect, low) : vec4(0.0, 0.0, 0.0, 1.0);
-    if (!emitters_alone) {
+    if (!emitters_alone && push.emitter_count == 0u) {
         if (LATTICE_CONES > 0u) {
             vec4 share = gather_lattice(p, start, n, 1.0, ao_volume_facing(n, with_ao), int(push.first_cone),
                                         int(push.cone_count));
@@ -121,20 +123,19 @@ void main() {
                                       int(vct.only_cone));
         }
     }
-    if (later_share) {
-        imageStore(indirect, low, gathered);
-        return;
-    }
     // The sampled emitters' light, which the voxels do not hold, joins the gathered
     // radiance as the cosine-weighted mean it adds: E / pi (not with `--cone`, a cone's
     // gather alone; alone in its debug view).
-    if (vct.only_cone == 0xffffffffu) {
-        gathered.rgb += sampled_emitter_light(p, start, n) / PI;
+    if (push.emitter_count > 0u && vct.only_cone == 0xffffffffu) {
+        gathered.rgb += sampled_emitter_light(p, start, n, push.first_emitter, push.emitter_count) / PI;
     }
     imageStore(indirect, low, gathered);
+    if (later_share && push.emitter_count == 0u) {
+        return;
+    }
     // Soft shadows change at the scale of the voxels, like the indirect light: their
     // cones are traced here too, four lights to a band of rows.
-    if ((frame.flags & FLAG_SHADOW_CONES) != 0u) {
+    if (!later_share && (frame.flags & FLAG_SHADOW_CONES) != 0u) {
         for (uint band = 0u; band * 4u < frame.light_count; band++) {
             vec4 visibility = vec4(1.0);
             for (uint i = 0u; i < 4u && band * 4u + i < frame.light_count; i++) {
@@ -149,7 +150,8 @@ void main() {
     }
     // The specular and refraction cones too: at 64^3 voxels a reflection is no sharper
     // than a few voxels. Their half-angle follows the roughness: tan(half) ~ roughness.
-    // One call site for both keeps the shader small (lavapipe inlines every call).
+    // One call site for both keeps the shader small (lavapipe inlines every call). The
+    // first dispatch traces them; each share of the emitters adds their light to them.
     vec3 v = normalize(frame.camera_position.xyz - p);
     float roughness = clamp(normal_roughness.w, 0.02, 1.0);
     vec2 transmission = imageLoad(gbuffer_transmission, pixel).rg;
@@ -159,14 +161,17 @@ void main() {
     // n faces the camera: the refracted ray enters the surface (relative index 1 / Ni).
     vec3 refracted = refract(-v, n, 1.0 / max(transmission.g, 1.0));
     vec3 dirs[2] = vec3[2](reflect(-v, n), dot(refracted, refracted) > 0.0 ? refracted : reflect(-v, n));
-    vec4 radiance[2] = vec4[2](vec4(0.0), vec4(0.0));
+    vec4 radiance[2] = later_share ? vec4[2](imageLoad(specular, low), imageLoad(transmitted, low))
+                                   : vec4[2](vec4(0.0), vec4(0.0));
     for (int c = 0; c < 2; c++) {
         if (traced[c]) {
             // The cone leaves the surface on the side it points to.
             vec3 side = dot(dirs[c], n) < 0.0 ? -n : n;
             vec3 origin = p + side * (2.0 * vct.origin.w);
-            radiance[c] = vec4(trace_cone(origin, dirs[c], roughness, 0.0, p, side, -1, vct.step_factor).rgb
-                                   + sampled_emitter_radiance(p, origin, side, dirs[c], roughness),
+            vec3 cone = later_share ? radiance[c].rgb
+                                    : trace_cone(origin, dirs[c], roughness, 0.0, p, side, -1, vct.step_factor).rgb;
+            radiance[c] = vec4(cone + sampled_emitter_radiance(p, origin, side, dirs[c], roughness,
+                                                               push.first_emitter, push.emitter_count),
                                1.0);
         }
     }
