@@ -479,13 +479,14 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
 // prefiltered opacity blends an occluder's one-voxel faces with the empty space around
 // them: it passed 18 % of the light in a block's full shadow at 64³ and 29 % at 128³,
 // where the narrow cone passes 3 % (`floor_under_an_emitter_takes_its_irradiance_and_shadow`).
-// Shadows come out as hard as from the emitter's centre. No sample blends the voxels of
-// either end's surface, which would shadow the light with the emitter itself or the
-// receiver: a lookup in cells of size f blends cells reaching 1.5 f from it, and a
-// surface's voxels reach a voxel from it (dilated by the voxelization), so a sample at
-// height h above either plane reads cells no larger than (h - voxel) / 1.5; samples too
-// near the receiver for a voxel are skipped, and the march stops where one would reach
-// the emitter. Each step is `vct.shadow_step_factor` of the cells read. The directional
+// Its shadow is as hard as from the emitter's centre; an emitter cut into pieces, each
+// with its own cone (src/gi/vct/emitters.rs), casts the mean of theirs. No sample blends
+// the voxels of either end's surface, which would shadow the light with the emitter
+// itself or the receiver: a lookup in cells of size f blends cells reaching 1.5 f from
+// it, and a surface's voxels reach a voxel from it (dilated by the voxelization), so a
+// sample at height h above either plane reads cells no larger than (h - voxel) / 1.5;
+// samples too near the receiver for a voxel are skipped, and the march stops where one
+// would reach the emitter. Each step is `vct.shadow_step_factor` of the cells read. The directional
 // volumes are read as a ray from the emitter meets them (along -dir): they hide a
 // surface from behind (gi/vct/anisotropic.glsl), and an occluder between the two is lit
 // on the emitter's side, which a cone from the receiver would see from behind and pass.
