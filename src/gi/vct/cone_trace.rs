@@ -23,11 +23,14 @@ use crate::vk::{compute_to_compute, groups_2d, Context, Pipeline};
 /// session 36). A GPU has no such limit and pays only the few extra reads of the
 /// G-buffer.
 const LATTICE_CONES_PER_DISPATCH: u32 = 24;
-/// The most sampled emitters whose light one dispatch adds, after the lattice's: each
-/// emitter's visibility cone marches through the voxels as a lattice cone does, and
-/// sixteen of them beside the lattice's first share ran past llvmpipe's loop budget in
-/// the octree at depth 7 (`cornell_area` cut into sixteen pieces: LDR-FLIP 0.112 against
-/// the dense grid's 0.059; BENCHMARKS.md, session 46).
+/// The most sampled emitters whose light one dispatch adds: each emitter's visibility
+/// cone marches through the voxels as a lattice cone does, and sixteen of them beside the
+/// lattice's first share ran past llvmpipe's loop budget in the octree at depth 7
+/// (`cornell_area` cut into sixteen pieces: LDR-FLIP 0.112 against the dense grid's
+/// 0.059; BENCHMARKS.md, session 46). The lattice's shares are full, so its emitters get
+/// dispatches of their own; the ring's one dispatch takes the first of them itself, as
+/// it took every emitter before, since a dispatch of its own cost frames' cone_trace 3
+/// to 7 % on the built-in box.
 const EMITTERS_PER_DISPATCH: u32 = 8;
 
 pub struct ConeTracePass {
@@ -84,22 +87,36 @@ impl ConeTracePass {
 }
 
 /// `lattice` cones (0: none) shared out over dispatches of at most
-/// LATTICE_CONES_PER_DISPATCH, as evenly as they go, then `emitters` over dispatches of
-/// at most EMITTERS_PER_DISPATCH.
+/// LATTICE_CONES_PER_DISPATCH, as evenly as they go, and `emitters` over dispatches of at
+/// most EMITTERS_PER_DISPATCH: after the lattice's, or, without it, the first in the
+/// ring's. Only the first dispatch has first cone and first emitter 0.
 fn shares(lattice: u32, emitters: u32) -> Vec<ConeTracePush> {
     let cones = lattice.div_ceil(LATTICE_CONES_PER_DISPATCH).max(1);
     let lights = emitters.div_ceil(EMITTERS_PER_DISPATCH);
-    let cone_shares = (0..cones).map(|i| ConeTracePush {
-        first_cone: lattice * i / cones,
-        cone_count: lattice * (i + 1) / cones - lattice * i / cones,
-        ..Default::default()
-    });
-    let emitter_shares = (0..lights).map(|i| ConeTracePush {
-        first_emitter: emitters * i / lights,
-        emitter_count: emitters * (i + 1) / lights - emitters * i / lights,
-        ..Default::default()
-    });
-    cone_shares.chain(emitter_shares).collect()
+    let mut shares: Vec<ConeTracePush> = (0..cones)
+        .map(|i| ConeTracePush {
+            first_cone: lattice * i / cones,
+            cone_count: lattice * (i + 1) / cones - lattice * i / cones,
+            ..Default::default()
+        })
+        .collect();
+    for i in 0..lights {
+        let (first_emitter, emitter_count) = (
+            emitters * i / lights,
+            emitters * (i + 1) / lights - emitters * i / lights,
+        );
+        if lattice == 0 && i == 0 {
+            shares[0].emitter_count = emitter_count;
+        } else {
+            shares.push(ConeTracePush {
+                first_cone: lattice,
+                first_emitter,
+                emitter_count,
+                ..Default::default()
+            });
+        }
+    }
+    shares
 }
 
 #[cfg(test)]
@@ -107,8 +124,8 @@ mod tests {
     use super::*;
 
     /// Every lattice cone and every emitter is traced once, no dispatch takes more than
-    /// its share or both kinds, only the first starts afresh (first cone 0, no
-    /// emitters), and without the lattice and emitters there is one dispatch.
+    /// its share or both kinds, only the first starts afresh (first cone and first
+    /// emitter 0), and without the lattice the ring's dispatch takes the first emitters.
     #[test]
     fn the_lattice_and_the_emitters_are_shared_out_whole() {
         for lattice in [0, 32, 48, 72, 73, 96, 256] {
@@ -116,24 +133,23 @@ mod tests {
                 let shares = shares(lattice, emitters);
                 let (mut cone, mut emitter) = (0, 0);
                 for (i, share) in shares.iter().enumerate() {
-                    assert_eq!(
-                        share.first_cone,
-                        if share.emitter_count > 0 { 0 } else { cone }
-                    );
+                    assert_eq!(share.first_cone, cone.min(lattice));
                     assert_eq!(share.first_emitter, emitter);
                     assert!(share.cone_count <= LATTICE_CONES_PER_DISPATCH);
                     assert!(share.emitter_count <= EMITTERS_PER_DISPATCH);
                     assert!(share.cone_count == 0 || share.emitter_count == 0);
-                    let fresh = share.first_cone == 0 && share.emitter_count == 0;
+                    let fresh = share.first_cone == 0 && share.first_emitter == 0;
                     assert_eq!(fresh, i == 0);
                     cone += share.cone_count;
                     emitter += share.emitter_count;
                 }
                 assert_eq!((cone, emitter), (lattice, emitters));
+                let ring_takes = u32::from(lattice == 0 && emitters > 0);
                 assert_eq!(
                     shares.len() as u32,
                     lattice.div_ceil(LATTICE_CONES_PER_DISPATCH).max(1)
                         + emitters.div_ceil(EMITTERS_PER_DISPATCH)
+                        - ring_takes
                 );
             }
         }

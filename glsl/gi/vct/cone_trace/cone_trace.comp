@@ -111,14 +111,16 @@ void main() {
     // says why they are split), adds to the earlier ones', the lattice's occlusion taken
     // from alpha (the ambient occlusion). One call site per kind of gather: each is
     // inlined.
-    bool later_share = push.first_cone > 0u || push.emitter_count > 0u;
+    bool later_share = push.first_cone > 0u || push.first_emitter > 0u;
     vec4 gathered = later_share ? imageLoad(indirect, low) : vec4(0.0, 0.0, 0.0, 1.0);
-    if (!emitters_alone && push.emitter_count == 0u) {
+    if (!emitters_alone) {
         if (LATTICE_CONES > 0u) {
-            vec4 share = gather_lattice(p, start, n, 1.0, ao_volume_facing(n, with_ao), int(push.first_cone),
-                                        int(push.cone_count));
-            gathered += vec4(share.rgb, -share.a);
-        } else {
+            if (push.cone_count > 0u) {
+                vec4 share = gather_lattice(p, start, n, 1.0, ao_volume_facing(n, with_ao), int(push.first_cone),
+                                            int(push.cone_count));
+                gathered += vec4(share.rgb, -share.a);
+            }
+        } else if (!later_share) {
             gathered = gather_diffuse(p, start, n, int(vct.diffuse_cones), 1.0, with_ao, vct.step_factor, true,
                                       int(vct.only_cone));
         }
