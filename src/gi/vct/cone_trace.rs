@@ -28,9 +28,9 @@ const LATTICE_CONES_PER_DISPATCH: u32 = 24;
 /// lattice's first share ran past llvmpipe's loop budget in the octree at depth 7
 /// (`cornell_area` cut into sixteen pieces: LDR-FLIP 0.112 against the dense grid's
 /// 0.059; BENCHMARKS.md, session 46). The lattice's shares are full, so its emitters get
-/// dispatches of their own; the ring's one dispatch takes the first of them itself, as
-/// it took every emitter before, since a dispatch of its own cost frames' cone_trace 3
-/// to 7 % on the built-in box.
+/// dispatches of their own. The ring's one dispatch takes them all, as before: frames
+/// keep one piece an emitter, and later dispatches cost the ring's cone_trace up to 12 %
+/// (a dispatch of their own, or the branch for them in its shader).
 const EMITTERS_PER_DISPATCH: u32 = 8;
 
 pub struct ConeTracePass {
@@ -88,10 +88,16 @@ impl ConeTracePass {
 
 /// `lattice` cones (0: none) shared out over dispatches of at most
 /// LATTICE_CONES_PER_DISPATCH, as evenly as they go, and `emitters` over dispatches of at
-/// most EMITTERS_PER_DISPATCH: after the lattice's, or, without it, the first in the
-/// ring's. Only the first dispatch has first cone and first emitter 0.
+/// most EMITTERS_PER_DISPATCH after them; without the lattice, one dispatch for the ring
+/// and every emitter. Only the first dispatch has first cone and first emitter 0.
 fn shares(lattice: u32, emitters: u32) -> Vec<ConeTracePush> {
     let cones = lattice.div_ceil(LATTICE_CONES_PER_DISPATCH).max(1);
+    if lattice == 0 {
+        return vec![ConeTracePush {
+            emitter_count: emitters,
+            ..Default::default()
+        }];
+    }
     let lights = emitters.div_ceil(EMITTERS_PER_DISPATCH);
     let mut shares: Vec<ConeTracePush> = (0..cones)
         .map(|i| ConeTracePush {
@@ -105,16 +111,12 @@ fn shares(lattice: u32, emitters: u32) -> Vec<ConeTracePush> {
             emitters * i / lights,
             emitters * (i + 1) / lights - emitters * i / lights,
         );
-        if lattice == 0 && i == 0 {
-            shares[0].emitter_count = emitter_count;
-        } else {
-            shares.push(ConeTracePush {
-                first_cone: lattice,
-                first_emitter,
-                emitter_count,
-                ..Default::default()
-            });
-        }
+        shares.push(ConeTracePush {
+            first_cone: lattice,
+            first_emitter,
+            emitter_count,
+            ..Default::default()
+        });
     }
     shares
 }
@@ -125,7 +127,7 @@ mod tests {
 
     /// Every lattice cone and every emitter is traced once, no dispatch takes more than
     /// its share or both kinds, only the first starts afresh (first cone and first
-    /// emitter 0), and without the lattice the ring's dispatch takes the first emitters.
+    /// emitter 0), and without the lattice one dispatch takes every emitter.
     #[test]
     fn the_lattice_and_the_emitters_are_shared_out_whole() {
         for lattice in [0, 32, 48, 72, 73, 96, 256] {
@@ -136,7 +138,7 @@ mod tests {
                     assert_eq!(share.first_cone, cone.min(lattice));
                     assert_eq!(share.first_emitter, emitter);
                     assert!(share.cone_count <= LATTICE_CONES_PER_DISPATCH);
-                    assert!(share.emitter_count <= EMITTERS_PER_DISPATCH);
+                    assert!(lattice == 0 || share.emitter_count <= EMITTERS_PER_DISPATCH);
                     assert!(share.cone_count == 0 || share.emitter_count == 0);
                     let fresh = share.first_cone == 0 && share.first_emitter == 0;
                     assert_eq!(fresh, i == 0);
@@ -144,12 +146,14 @@ mod tests {
                     emitter += share.emitter_count;
                 }
                 assert_eq!((cone, emitter), (lattice, emitters));
-                let ring_takes = u32::from(lattice == 0 && emitters > 0);
+                let later = if lattice == 0 {
+                    0
+                } else {
+                    emitters.div_ceil(EMITTERS_PER_DISPATCH)
+                };
                 assert_eq!(
                     shares.len() as u32,
-                    lattice.div_ceil(LATTICE_CONES_PER_DISPATCH).max(1)
-                        + emitters.div_ceil(EMITTERS_PER_DISPATCH)
-                        - ring_takes
+                    lattice.div_ceil(LATTICE_CONES_PER_DISPATCH).max(1) + later
                 );
             }
         }

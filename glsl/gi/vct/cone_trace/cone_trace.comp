@@ -109,9 +109,9 @@ void main() {
     bool emitters_alone = frame.debug_view == DEBUG_EMITTER_LIGHT;
     // A later dispatch, a share of the lattice or of the sampled emitters (cone_trace.rs
     // says why they are split), adds to the earlier ones', the lattice's occlusion taken
-    // from alpha (the ambient occlusion). One call site per kind of gather: each is
-    // inlined.
-    bool later_share = push.first_cone > 0u || push.first_emitter > 0u;
+    // from alpha (the ambient occlusion). The ring has one dispatch: its shader keeps no
+    // branch for later ones. One call site per kind of gather: each is inlined.
+    bool later_share = LATTICE_CONES > 0u && (push.first_cone > 0u || push.first_emitter > 0u);
     vec4 gathered = later_share ? imageLoad(indirect, low) : vec4(0.0, 0.0, 0.0, 1.0);
     if (!emitters_alone) {
         if (LATTICE_CONES > 0u) {
