@@ -584,10 +584,10 @@ gpu_layout! {
         uint first_triangle,
         /// How many triangles it has.
         uint triangle_count,
+        /// On the first piece of an emitter cut into pieces (`--emitter-pieces`), how many pieces it was cut into, this one and those right after it; 0 on the others.
+        uint group_pieces,
         /// Unused.
         uint pad0,
-        /// Unused.
-        uint pad1,
     }
 
     /// A triangle of a sampled emitter, in world space, wound so that it emits along its emitter's plane normal.

@@ -23,7 +23,10 @@
 //! view, the whole penumbra dark). So the pieces are cut, the longest first, into up to
 //! `VctSettings::emitter_pieces` parts of at least a voxel, each an emitter with its own
 //! cone: the shadow becomes the mean of the parts' (0.79 with 8), and the parts'
-//! irradiances still sum to the piece's exactly.
+//! irradiances still sum to the piece's exactly. The specular and refraction cones take
+//! each whole emitter's share of their solid angle (the parts' vector irradiances summed):
+//! a share taken part by part, each as a disc, misses a narrow cone aimed where parts
+//! meet.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -143,6 +146,7 @@ pub fn sampled_emitters(
             .collect();
         for group in planar_pieces(&triangles, extent) {
             pieces.push(Part {
+                whole: pieces.len(),
                 material: m,
                 normal: group.normal,
                 triangles: group.members.iter().map(|&i| triangles[i]).collect(),
@@ -151,8 +155,19 @@ pub fn sampled_emitters(
     }
     let whole = pieces.len();
     cut(&mut pieces, parts, smallest);
-    for part in &pieces {
+    // Each emitter's pieces side by side, the first counting them (`group_pieces`).
+    pieces.sort_by_key(|p| p.whole);
+    for (i, part) in pieces.iter().enumerate() {
         let normal = part.normal;
+        let first = i == 0 || pieces[i - 1].whole != part.whole;
+        let group_pieces = if first {
+            pieces[i..]
+                .iter()
+                .take_while(|p| p.whole == part.whole)
+                .count() as u32
+        } else {
+            0
+        };
         out.emitters.push(VctEmitter {
             plane: normal.extend(normal.dot(part.triangles[0][0])).to_array(),
             radiance: scene.materials[part.material]
@@ -161,6 +176,7 @@ pub fn sampled_emitters(
                 .to_array(),
             first_triangle: out.triangles.len() as u32,
             triangle_count: part.triangles.len() as u32,
+            group_pieces,
             ..Default::default()
         });
         out.triangles
@@ -178,8 +194,9 @@ pub fn sampled_emitters(
     out
 }
 
-/// A sampled emitter: triangles of one material in one plane.
+/// A sampled emitter: triangles of one material in one plane, of the `whole` emitter.
 struct Part {
+    whole: usize,
     material: usize,
     normal: Vec3,
     triangles: Vec<[Vec3; 3]>,
@@ -219,9 +236,10 @@ fn cut(pieces: &mut Vec<Part>, parts: usize, smallest: f32) {
         if below.is_empty() || above.is_empty() {
             return;
         }
-        let (material, normal) = (pieces[i].material, pieces[i].normal);
+        let (whole, material, normal) = (pieces[i].whole, pieces[i].material, pieces[i].normal);
         pieces[i].triangles = below;
         pieces.push(Part {
+            whole,
             material,
             normal,
             triangles: above,
@@ -377,6 +395,7 @@ mod tests {
         ];
         let rectangle = || {
             vec![Part {
+                whole: 0,
                 material: 0,
                 normal: Vec3::Z,
                 triangles: vec![[a, b, c], [a, c, d]],

@@ -53,8 +53,9 @@ float disc_overlap(float a, float b, float d) {
          + b * b * acos(clamp((d * d + b * b - a * a) / (2.0 * d * b), -1.0, 1.0)) - 0.5 * lens;
 }
 
-// The radiance of `count` sampled emitters from `first` averaged over the cone from
-// `origin` along `dir` of
+// The radiance of the sampled emitters whose first pieces lie among the `count` from
+// `first` (each emitter whole, its pieces' phi summed: a piece's disc would miss a narrow
+// cone aimed where pieces meet) averaged over the cone from `origin` along `dir` of
 // half-angle atan(tan_half) (a specular or refraction cone leaving the surface at p on
 // its `side`): the voxels the cone marches do not hold it. Each emitter covers the share
 // of the cone that a disc of its solid angle |phi| about phi's direction (phi over the
@@ -66,7 +67,10 @@ vec3 sampled_emitter_radiance(vec3 p, vec3 origin, vec3 side, vec3 dir, float ta
     vec3 radiance = vec3(0.0);
     for (uint i = first; i < first + count; i++) {
         VctEmitter emitter = vct_emitters[i];
-        vec3 phi = emitter_phi(emitter, p, dir);
+        vec3 phi = vec3(0.0);
+        for (uint k = 0u; k < emitter.group_pieces; k++) {
+            phi += emitter_phi(vct_emitters[i + k], p, dir);
+        }
         float solid = length(phi);
         if (solid <= 0.0) {
             continue;
