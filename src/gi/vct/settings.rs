@@ -77,7 +77,8 @@ pub enum Quality {
     Fast,
     /// For one image (`render`): the lattice of [`LATTICE_CONES`] cones, whose error falls
     /// as the voxels get finer, at the most voxels the device's memory holds (up to
-    /// [`MOST_VOXELS`]), on a CPU driver too. The ring's options (`--diffuse-cones`,
+    /// [`MOST_VOXELS`]), on a CPU driver too, the sampled emitters cut into
+    /// [`EMITTER_PIECES`] pieces. The ring's options (`--diffuse-cones`,
     /// `--cosine-cones`, `--snapped-cones`, the steps' factors, `--cone`) keep the ring
     Accurate,
 }
