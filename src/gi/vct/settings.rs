@@ -72,13 +72,13 @@ pub enum DirectionalFilter {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Quality {
-    /// For frames in real time (`view` and `bench`): the ring of `--diffuse-cones`,
-    /// [`CPU_VOXELS`] per axis on a CPU driver
+    /// For frames in real time (`view` and `bench`): the ring of `--diffuse-cones`, 64³
+    /// on a CPU driver (`CPU_VOXELS`), whole sampled emitters
     Fast,
-    /// For one image (`render`): the lattice of [`LATTICE_CONES`] cones, whose error falls
-    /// as the voxels get finer, at the most voxels the device's memory holds (up to
-    /// [`MOST_VOXELS`]), on a CPU driver too, the sampled emitters cut into
-    /// [`EMITTER_PIECES`] pieces. The ring's options (`--diffuse-cones`,
+    /// For one image (`render`): the lattice of 72 cones (`LATTICE_CONES`), whose error
+    /// falls as the voxels get finer, at the most voxels the device's memory holds (up to
+    /// 256³, `MOST_VOXELS`), on a CPU driver too, the sampled emitters cut into 8 pieces
+    /// (`EMITTER_PIECES`). The ring's options (`--diffuse-cones`,
     /// `--cosine-cones`, `--snapped-cones`, the steps' factors, `--cone`) keep the ring
     Accurate,
 }
