@@ -486,10 +486,11 @@ float cone_visibility(vec3 origin, vec3 dir, float tan_half, float max_dist) {
 // it, and a surface's voxels reach a voxel from it (dilated by the voxelization), so a
 // sample at height h above either plane reads cells no larger than (h - voxel) / 1.5;
 // samples too near the receiver for a voxel are skipped, and the march stops where one
-// would reach the emitter. Each step is `vct.shadow_step_factor` of the cells read. The directional
-// volumes are read as a ray from the emitter meets them (along -dir): they hide a
-// surface from behind (gi/vct/anisotropic.glsl), and an occluder between the two is lit
-// on the emitter's side, which a cone from the receiver would see from behind and pass.
+// would reach the emitter. Each step is `vct.shadow_step_factor` of the cells read. The
+// directional volumes are read as a ray from the emitter meets them (along -dir): they
+// hide a surface from behind (gi/vct/anisotropic.glsl), and an occluder between the two
+// is lit on the emitter's side, which a cone from the receiver would see from behind and
+// pass.
 float emitter_visibility(vec3 origin, vec3 surface, vec3 n, vec3 dir, vec4 plane) {
     float voxel = vct.origin.w;
     float grid_size = voxel * float(vct.resolution);

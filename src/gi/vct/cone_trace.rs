@@ -91,13 +91,13 @@ impl ConeTracePass {
 /// most EMITTERS_PER_DISPATCH after them; without the lattice, one dispatch for the ring
 /// and every emitter. Only the first dispatch has first cone and first emitter 0.
 fn shares(lattice: u32, emitters: u32) -> Vec<ConeTracePush> {
-    let cones = lattice.div_ceil(LATTICE_CONES_PER_DISPATCH).max(1);
     if lattice == 0 {
         return vec![ConeTracePush {
             emitter_count: emitters,
             ..Default::default()
         }];
     }
+    let cones = lattice.div_ceil(LATTICE_CONES_PER_DISPATCH);
     let lights = emitters.div_ceil(EMITTERS_PER_DISPATCH);
     let mut shares: Vec<ConeTracePush> = (0..cones)
         .map(|i| ConeTracePush {

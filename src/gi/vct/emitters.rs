@@ -36,7 +36,7 @@ use ash::vk;
 use glam::Vec3;
 
 use crate::gpu_layout::{VctEmitter, VctEmitterTriangle};
-use crate::scene::{Material, Scene};
+use crate::scene::{Aabb, Material, Scene};
 use crate::vk::{Buffer, Context};
 
 /// The sampled emitters, their triangles, and the material bits (`BINDING_VCT_SAMPLED_MATERIALS`).
@@ -207,13 +207,10 @@ struct Part {
 /// none is longer than `smallest`.
 fn cut(pieces: &mut Vec<Part>, parts: usize, smallest: f32) {
     let longest = |t: &[[Vec3; 3]]| {
-        let (lo, hi) = t.iter().flatten().fold(
-            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-        );
-        let size = hi - lo;
+        let bounds = bounds(t);
+        let size = bounds.size();
         let axis = (0..3).fold(0, |best, k| if size[k] > size[best] { k } else { best });
-        (size[axis], axis, 0.5 * (lo[axis] + hi[axis]))
+        (size[axis], axis, bounds.center()[axis])
     };
     while pieces.len() < parts {
         let Some((i, (size, axis, middle))) = pieces
@@ -245,6 +242,12 @@ fn cut(pieces: &mut Vec<Part>, parts: usize, smallest: f32) {
             triangles: above,
         });
     }
+}
+
+fn bounds(triangles: &[[Vec3; 3]]) -> Aabb {
+    let mut bounds = Aabb::EMPTY;
+    triangles.iter().flatten().for_each(|&p| bounds.extend(p));
+    bounds
 }
 
 /// A cut through a corner leaves a triangle of no area, which no emitter needs.
@@ -410,11 +413,8 @@ mod tests {
                 let area: f32 = part.triangles.iter().map(area).sum();
                 assert!((area - side * side).abs() < 1e-5, "{area}");
                 total += area;
-                let (lo, hi) = part.triangles.iter().flatten().fold(
-                    (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-                    |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-                );
-                assert!(((hi - lo) - Vec3::new(side, side, 0.0)).abs().max_element() < 1e-5);
+                let size = bounds(&part.triangles).size();
+                assert!((size - Vec3::new(side, side, 0.0)).abs().max_element() < 1e-5);
                 for t in &part.triangles {
                     assert!((t[1] - t[0]).cross(t[2] - t[0]).z > 0.0, "{t:?}");
                 }
