@@ -126,8 +126,8 @@ gpu_layout! {
         BINDING_VCT_SAMPLED_MATERIALS = 13;
 
         /// Dense grid (set 3, after the shared bindings): per voxel, the sums of its fragments'
-        /// albedo, normal and emission (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` texels
-        /// of an `r32ui` storage image of 2n x n x 5n texels (`glsl/gi/vct/sums.glsl`), from which the
+        /// albedo, normal, emission and coverage (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` texels
+        /// of an `r32ui` storage image of 2n x n x 7n texels (`glsl/gi/vct/sums.glsl`), from which the
         /// compact pass takes the means. Atomic adds are exact and commutative, so the means do not
         /// depend on the order in which fragments arrive.
         BINDING_DENSE_SUMS = 14;
@@ -161,9 +161,9 @@ gpu_layout! {
         /// dense grid binds volumes): `OctreeCounters` then `OctreeLevel[OCTREE_MAX_LEVELS]`,
         /// storage buffer.
         BINDING_OCTREE_COUNTERS = 14;
-        /// Octree (set 3): the voxel-fragment list, first half: the fragments' voxels (x | y << 10 | z << 20), then their RGBA8 albedos (from `OctreeCounters.fragment_capacity` on; the octree's passes read only the voxels), `uint[]` storage buffer. (Two halves of 8 bytes, so that each fits the 128 MiB that lavapipe binds at depth 9.)
+        /// Octree (set 3): the voxel-fragment list, first half: the fragments' voxels (x | y << 10 | z << 20), then their RGBA8 albedos, alpha the coverage across x (from `OctreeCounters.fragment_capacity` on; the octree's passes read only the voxels), `uint[]` storage buffer. (Two halves of 8 bytes, so that each fits the 128 MiB that lavapipe binds at depth 9.)
         BINDING_OCTREE_FRAGMENTS = 15;
-        /// Octree (set 3): the voxel-fragment list, second half: per fragment its RGBA8 normal (xyz * 0.5 + 0.5) and emission / `VctUniforms.emission_range`, `uvec2[]` storage buffer.
+        /// Octree (set 3): the voxel-fragment list, second half: per fragment its RGBA8 normal (xyz * 0.5 + 0.5) and emission / `VctUniforms.emission_range`, alpha the coverage across y and z, `uvec2[]` storage buffer.
         BINDING_OCTREE_FRAGMENT_SHADING = 16;
         /// Octree (set 3): per node, its first child (children come in tiles of 8; 0 = none) with `OCTREE_SUBDIVIDE` set while flagged; for a leaf, which of its 8 voxels hold fragments (bits 0-7, voxel x | y << 1 | z << 2) and the first of their sums (bits 8-31; a leaf is flagged in its coordinates instead, `OCTREE_LEAF_FLAGGED`), `uint[]` storage buffer.
         BINDING_OCTREE_NODES = 17;
@@ -175,7 +175,7 @@ gpu_layout! {
         BINDING_OCTREE_NEIGHBOURS = 20;
         /// Octree (set 3): the interior bricks' six directional radiances, `rgba16f` storage (sampled at `BINDING_VCT_DIRECTIONAL`).
         BINDING_OCTREE_DIRECTIONAL_STORAGE = 21;
-        /// Octree (set 3): per occupied leaf voxel, the sums of its fragments' albedo, normal and emission (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` words of a `uint[]` storage buffer: atomic adds are exact and commutative, so the averages do not depend on the order the fragments were listed in.
+        /// Octree (set 3): per occupied leaf voxel, the sums of its fragments' albedo, normal, emission and coverage (RGB, 0..255 each) and their count, `VOXEL_SUM_WORDS` words of a `uint[]` storage buffer: atomic adds are exact and commutative, so the averages do not depend on the order the fragments were listed in.
         BINDING_OCTREE_SUMS = 22;
         /// Octree (set 3): the light each leaf voxel in a new brick gathered in the last frame, for the same voxel in the next frame's octree rebuilt around moving meshes (which gives it a new brick again): two hash tables of `carry_capacity` entries (key = voxel x | y << 10 | z << 20, plus 1; then the RGB floats), `uint[]` storage buffer.
         BINDING_OCTREE_CARRY = 23;
@@ -188,8 +188,15 @@ gpu_layout! {
         /// Octree (set 3): the node grid, a dense index into the octree at level `depth - 1 - OCTREE_NODE_GRID_ABOVE_LEAVES` (`glsl/gi/vct/octree/nodes/grid.comp`): per cell, its node there, or `OCTREE_GRID_GAP` plus the level of the childless node above where its cube is empty; cone samples start their descent from it, `uint[]` storage buffer.
         BINDING_OCTREE_NODE_GRID = 27;
         /// Words of a voxel's fragment sums (dense grid and octree alike): albedo RGB, normal
-        /// XYZ, emission RGB, then the fragment count (`glsl/gi/vct/sums.glsl`).
-        VOXEL_SUM_WORDS = 10;
+        /// XYZ, emission RGB, coverage XYZ, then the fragment count (`glsl/gi/vct/sums.glsl`).
+        VOXEL_SUM_WORDS = 13;
+        /// Voxel cone tracing (set 3, numbered after both stores' own): each voxel's coverage, the
+        /// share of its cross-section across x, y and z that its surfaces cover (RGB; alpha 1 where
+        /// occupied), `rgba8` storage (the octree: leaf coverage bricks laid out as its leaf radiance
+        /// bricks, borders included).
+        BINDING_VCT_COVERAGE = 28;
+        /// Voxel cone tracing (set 3): the same coverage, `sampler3D`.
+        BINDING_VCT_COVERAGE_SAMPLED = 29;
         /// Levels between the node grid and the leaves: samples of the finest levels descend at most this far from the grid (from the root, 7 more at depth 10).
         OCTREE_NODE_GRID_ABOVE_LEAVES = 3;
         /// A node grid entry at or above this is no node: the cell is empty from level (entry - `OCTREE_GRID_GAP`) down.
@@ -220,6 +227,8 @@ gpu_layout! {
         SPEC_LATTICE_CONES = 2;
         /// Specialization constant id, given to every pipeline of voxel cone tracing: 1 where the voxel store (the dense grid or the octree) keeps each cell's surface plane and the snapped cones count a plane they run beside as the same rays from cell to cell (`Store::planes`, `PLANE_SLOT`); 0 where every cell's opacity is composited as uncorrelated. A constant for the reason `SPEC_SNAPPED_CONES` is one.
         SPEC_PLANE_OCCLUSION = 3;
+        /// Specialization constant id, given to every pipeline of voxel cone tracing: 1 where the voxelization takes each voxel's coverage (`BINDING_VCT_COVERAGE`) for the snapped cones that read the base voxels (the sampled emitters' visibility, the specular and refraction cones, the soft-shadow cones); 0 where nothing reads it and an occupied voxel counts as covered across every axis. A constant: lavapipe ran the clipping that takes it even behind a uniform branch not taken (Sponza's voxelization 0.97 s without the code, 2.87 s with it).
+        SPEC_VOXEL_COVERAGE = 4;
         /// Specialization constant id of the shadow pass: 1 where cut-outs cast whole shadows whatever their coverage (`RenderSettings::opaque_shadow_cut_outs`, the references' convention), 0 where they cast none where cut.
         SPEC_SHADOW_OPAQUE_CUT_OUTS = 0;
         /// Workgroup size of the passes over fragments and over a level's nodes.

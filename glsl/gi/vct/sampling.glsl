@@ -10,16 +10,22 @@
 
 layout(set = SET_GI, binding = BINDING_VCT_RADIANCE_SAMPLED) uniform sampler3D voxel_radiance;
 layout(set = SET_GI, binding = BINDING_VCT_DIRECTIONAL) uniform sampler3D voxel_directional;
-
-// `--snapped-cones` (SNAPPED_CONES in cones.glsl), fixed when the pipeline is made: as a
-// uniform tested in branches, lavapipe inlined it and compiled the passes anew at every
-// bind (see SPEC_SNAPPED_CONES).
-layout(constant_id = SPEC_SNAPPED_CONES) const bool SNAPPED_CONES = false;
+// Each base voxel's coverage across x, y and z (gi/vct/voxelize/coverage.glsl), alpha its
+// occupancy.
+layout(set = SET_GI, binding = BINDING_VCT_COVERAGE_SAMPLED) uniform sampler3D voxel_coverage;
 
 // Along one axis, the index of the cell, of `cells` across the grid, that holds the
 // texture coordinate `u` (`--snapped-cones`).
 float cell_holding(float u, float cells) {
     return min(floor(clamp(u, 0.0, 1.0) * cells), cells - 1.0);
+}
+
+// A base-level sample `s` (radiance premultiplied by occupancy) as a cone crossing its
+// voxels along an axis meets them: opaque across `covered`, the covered share of their
+// cross-section (sampled as `s` was), where occupancy counts every voxel a surface
+// touches as opaque however little of it the surface covers.
+vec4 across_covered(vec4 s, float covered) {
+    return s.a > 1e-4 ? vec4(s.rgb * (covered / s.a), covered) : vec4(0.0);
 }
 
 #ifndef OCTREE
@@ -36,13 +42,15 @@ float cell_centre(float u, float cells) {
 }
 
 // The base level at `uvw` read three times, each at the centre of the voxel that holds
-// uvw along one axis (sx along x, and so on) and trilinearly across it
-// (`--snapped-cones`).
+// uvw along one axis (sx along x, and so on) and trilinearly across it, opaque across
+// the voxels' coverage across that axis (`--snapped-cones`).
 void sample_base_snapped(vec3 uvw, out vec4 sx, out vec4 sy, out vec4 sz) {
     float cells = float(vct.resolution);
-    sx = textureLod(voxel_radiance, vec3(cell_centre(uvw.x, cells), uvw.yz), 0.0);
-    sy = textureLod(voxel_radiance, vec3(uvw.x, cell_centre(uvw.y, cells), uvw.z), 0.0);
-    sz = textureLod(voxel_radiance, vec3(uvw.xy, cell_centre(uvw.z, cells)), 0.0);
+    vec3 at[3] = vec3[3](vec3(cell_centre(uvw.x, cells), uvw.yz), vec3(uvw.x, cell_centre(uvw.y, cells), uvw.z),
+                         vec3(uvw.xy, cell_centre(uvw.z, cells)));
+    sx = across_covered(textureLod(voxel_radiance, at[0], 0.0), textureLod(voxel_coverage, at[0], 0.0).x);
+    sy = across_covered(textureLod(voxel_radiance, at[1], 0.0), textureLod(voxel_coverage, at[1], 0.0).y);
+    sz = across_covered(textureLod(voxel_radiance, at[2], 0.0), textureLod(voxel_coverage, at[2], 0.0).z);
 }
 
 // Where `uvw` of the directional volume d (+X -X +Y -Y +Z -Z, with the planes
@@ -155,11 +163,24 @@ bool locate(vec3 uvw, uint level, out BrickSample s) {
     return false;
 }
 
-// Leaf radiance, trilinear, at a located place.
-vec4 read_leaf(BrickSample s) {
+// Where a located place lies in the leaf radiance pool (and the coverage pool, laid out
+// alike), in texture coordinates.
+vec3 leaf_texel(BrickSample s) {
     float edge = float(counters.leaf_pool_side * OCTREE_RADIANCE_BRICK);
     vec3 texel = vec3(brick_origin(s.brick, counters.leaf_pool_side, OCTREE_RADIANCE_BRICK)) + 1.0 + s.local;
-    return textureLod(voxel_radiance, texel / edge, 0.0);
+    return texel / edge;
+}
+
+// Leaf radiance, trilinear, at a located place.
+vec4 read_leaf(BrickSample s) {
+    return textureLod(voxel_radiance, leaf_texel(s), 0.0);
+}
+
+// Leaf radiance at a located place as a cone crossing it along `axis` meets it
+// (across_covered).
+vec4 read_leaf_across(BrickSample s, int axis) {
+    vec3 at = leaf_texel(s);
+    return across_covered(textureLod(voxel_radiance, at, 0.0), textureLod(voxel_coverage, at, 0.0)[axis]);
 }
 
 // Directional radiance d of an interior brick, trilinear, at a located place. The six
@@ -195,9 +216,9 @@ void sample_base_snapped(vec3 uvw, out vec4 sx, out vec4 sy, out vec4 sz) {
         sz = vec4(0.0);
         return;
     }
-    sx = read_leaf(snapped(s, 0, uvw, level));
-    sy = read_leaf(snapped(s, 1, uvw, level));
-    sz = read_leaf(snapped(s, 2, uvw, level));
+    sx = read_leaf_across(snapped(s, 0, uvw, level), 0);
+    sy = read_leaf_across(snapped(s, 1, uvw, level), 1);
+    sz = read_leaf_across(snapped(s, 2, uvw, level), 2);
 }
 
 // Directional level `level` (0: voxels twice the leaves' size) is held by the interior

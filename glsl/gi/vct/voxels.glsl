@@ -9,6 +9,15 @@ layout(set = SET_GI, binding = BINDING_VCT_UNIFORMS) uniform VctBlock {
     VctUniforms vct;
 };
 
+// `--snapped-cones` (SNAPPED_CONES in cones.glsl), fixed when the pipeline is made: as a
+// uniform tested in branches, lavapipe inlined it and compiled the passes anew at every
+// bind (see SPEC_SNAPPED_CONES).
+layout(constant_id = SPEC_SNAPPED_CONES) const bool SNAPPED_CONES = false;
+
+// Whether the voxelization takes each voxel's coverage (gi/vct/voxelize/coverage.glsl),
+// where some cone reads it (`reads_coverage` in src/gi/vct/mod.rs; SPEC_VOXEL_COVERAGE).
+layout(constant_id = SPEC_VOXEL_COVERAGE) const bool VOXEL_COVERAGE = false;
+
 // Whether the cells keep their surface planes (cones.glsl, plane_increment; PLANE_SLOT of
 // the directional volumes; `--no-plane-occlusion`), fixed when the pipeline is made, for
 // the reason SNAPPED_CONES is.

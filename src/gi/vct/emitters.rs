@@ -22,7 +22,8 @@
 //! floor under a block lit by a square emitter took 0.24 of the path tracer's light in
 //! view, the whole penumbra dark). So the pieces are cut, the longest first, into up to
 //! `VctSettings::emitter_pieces` parts of at least a voxel, each an emitter with its own
-//! cone: the shadow becomes the mean of the parts' (0.79 with 8), and the parts'
+//! cone: the shadow becomes the mean of the parts' (0.79 with 8; 0.90 since the narrow
+//! cones read the voxels' coverage, `sample_base_snapped`), and the parts'
 //! irradiances still sum to the piece's exactly. The specular and refraction cones take
 //! each whole emitter's share of their solid angle (the parts' vector irradiances summed):
 //! a share taken part by part, each as a disc, misses a narrow cone aimed where parts

@@ -153,9 +153,10 @@ pub const LATTICE_CONES: u32 = 72;
 /// and renders a reference scene in 27 to 86 s on lavapipe with the lattice; 512³ has
 /// eight times the voxels and 16 GiB of grid.
 pub const MOST_VOXELS: u32 = 256;
-/// The dense grid's bytes per voxel, volumes, their mips and the fragment sums (`bench`'s
-/// `memory_mib`: 2011 MiB at 256³).
-const BYTES_PER_VOXEL: u64 = 126;
+/// The dense grid's bytes per voxel, volumes, their mips and the fragment sums, the
+/// static meshes' too (`bench`'s `memory_mib`: 2011 MiB at 256³ before the voxels'
+/// coverage, session 47, which adds 4 bytes and 16 to each sums image: 2592 MiB).
+const BYTES_PER_VOXEL: u64 = 162;
 
 /// Voxels per axis when none are given.
 /// - The device sets the most: [`CPU_VOXELS`] on a CPU driver in real time (`memory` is
@@ -224,12 +225,13 @@ pub struct VctSettings {
 /// `VctSettings::emitter_pieces` for one image ([`Quality::Accurate`]) unless the command
 /// line or the scene file says otherwise. On a floor under a block lit by a square
 /// emitter, at 128³, the light in view is 0.24 of the path tracer's with one piece and
-/// 0.79 with four to 256 (the rest is the block's voxels, whose shadow is 1.4 voxels too
-/// wide); more pieces spread it better over the penumbra (32x32 blocks off by 0.38, 0.33
-/// and 0.29 on average with 4, 8 and 16). Eight: sixteen spread it a little better for
-/// twice the cones, and `cornell_area`'s emitter light per block barely moves (off by
-/// 0.087 with one piece, 0.072 with eight, 0.070 with sixteen; BENCHMARKS.md, session
-/// 46). Frames keep one: each piece costs every traced point a cone.
+/// 0.79 with four to 256 (the rest is the block's voxels, whose shadow was 1.4 voxels too
+/// wide; 0.44 and 0.90 with one and eight pieces since the narrow cones read the voxels'
+/// coverage, session 47); more pieces spread it better over the penumbra (32x32 blocks
+/// off by 0.38, 0.33 and 0.29 on average with 4, 8 and 16). Eight: sixteen spread it a
+/// little better for twice the cones, and `cornell_area`'s emitter light per block barely
+/// moves (off by 0.087 with one piece, 0.072 with eight, 0.070 with sixteen; BENCHMARKS.md,
+/// session 46). Frames keep one: each piece costs every traced point a cone.
 pub const EMITTER_PIECES: u32 = 8;
 
 /// `VctSettings::sampled_emitters` unless the command line or the scene file says otherwise.
@@ -427,8 +429,8 @@ mod tests {
         // A CPU driver in real time: 64³ whatever the wanted size.
         assert_eq!(auto_voxels(None, 10.0, None, true), CPU_VOXELS);
         assert_eq!(auto_voxels(None, 10.0, Some(0.001), true), CPU_VOXELS);
-        // A GPU, or one image, with 80 GiB: 256³ (2 GiB of grid); with 4 GiB, a quarter is
-        // 1 GiB: 128³.
+        // A GPU, or one image, with 80 GiB: 256³ (2.5 GiB of grid); with 4 GiB, a quarter
+        // is 1 GiB: 128³.
         assert_eq!(auto_voxels(Some(80 * GIB), 10.0, None, true), MOST_VOXELS);
         assert_eq!(auto_voxels(Some(4 * GIB), 10.0, None, true), 128);
         assert_eq!(auto_voxels(Some(GIB / 4), 10.0, None, true), CPU_VOXELS);

@@ -90,7 +90,10 @@ void main() {
         if (frame.debug_view == DEBUG_VOXEL_RADIANCE) {
             // The cell's centre, so that the view shows the cells unfiltered.
             vec3 uvw = (vec3(c) + 0.5) * cell / grid_size;
-            vec4 s = sample_voxels(uvw, dir, float(level));
+            // At level 0 the voxels themselves, opaque where occupied: a cone meets them
+            // across their coverage (sample_base_snapped), through which a thin ray
+            // passing a turned plane's voxels at their corners would see nothing.
+            vec4 s = level == 0 ? sample_base(uvw) : sample_voxels(uvw, dir, float(level));
             float a = 1.0 - pow(1.0 - clamp(s.a, 0.0, 0.9999), 0.25);
             acc.rgb += (1.0 - acc.a) * (s.a > 1e-4 ? s.rgb * (a / s.a) : vec3(0.0));
             acc.a += (1.0 - acc.a) * a;

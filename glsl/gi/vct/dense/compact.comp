@@ -1,8 +1,9 @@
 #version 460
 // Takes each voxel's attribute means from its fragment sums (gi/sums.glsl; with moving
 // meshes, this frame's sums plus the static meshes') into the albedo, normal and emission
-// volumes, zeroes this frame's sums for the next voxelization and the voxel's radiance
-// and direct light (injection writes those of the listed voxels only); a voxel empty now
+// volumes and its coverage into the coverage volume, zeroes this frame's sums for the next
+// voxelization and the voxel's radiance and direct light (injection writes those of the
+// listed voxels only); a voxel empty now
 // and before keeps its zeros untouched. It lists the occupied voxels, so that voxel
 // shading and bounces run one invocation per occupied voxel instead of one per grid cell
 // (a wall fills a quarter to a half of the cells of the workgroups it crosses, and idle
@@ -19,6 +20,7 @@ layout(set = SET_GI, binding = BINDING_DENSE_STATIC_SUMS, r32ui) uniform readonl
 layout(set = SET_GI, binding = BINDING_VCT_ALBEDO, r32ui) uniform uimage3D voxel_albedo;
 layout(set = SET_GI, binding = BINDING_VCT_NORMAL, r32ui) uniform writeonly uimage3D voxel_normal;
 layout(set = SET_GI, binding = BINDING_VCT_EMISSION, r32ui) uniform writeonly uimage3D voxel_emission;
+layout(set = SET_GI, binding = BINDING_VCT_COVERAGE, rgba8) uniform writeonly image3D voxel_coverage;
 layout(set = SET_GI, binding = BINDING_VCT_RADIANCE, rgba16f) uniform writeonly image3D voxel_radiance;
 layout(set = SET_GI, binding = BINDING_VCT_DIRECT, rgba16f) uniform writeonly image3D voxel_direct;
 
@@ -43,12 +45,15 @@ void main() {
         return;
     }
     uint means[3] = uint[3](0u, 0u, 0u);
+    uvec3 sums[4] = uvec3[4](uvec3(0u), uvec3(0u), uvec3(0u), uvec3(0u));
     if (count != 0u) {
+        for (uint a = 0u; a < (VOXEL_COVERAGE ? 4u : 3u); a++) {
+            sums[a] = uvec3(sum_word(voxel, 3u * a, fresh, kept),
+                            sum_word(voxel, 3u * a + 1u, fresh, kept),
+                            sum_word(voxel, 3u * a + 2u, fresh, kept));
+        }
         for (uint a = 0u; a < 3u; a++) {
-            uvec3 sum = uvec3(sum_word(voxel, 3u * a, fresh, kept),
-                              sum_word(voxel, 3u * a + 1u, fresh, kept),
-                              sum_word(voxel, 3u * a + 2u, fresh, kept));
-            means[a] = packed_mean(sum, count);
+            means[a] = packed_mean(sums[a], count);
         }
     }
     if (fresh) {
@@ -59,6 +64,7 @@ void main() {
     imageStore(voxel_albedo, voxel, uvec4(means[0]));
     imageStore(voxel_normal, voxel, uvec4(means[1]));
     imageStore(voxel_emission, voxel, uvec4(means[2]));
+    imageStore(voxel_coverage, voxel, coverage_of(sums[3], count));
     imageStore(voxel_radiance, voxel, vec4(0.0));
     imageStore(voxel_direct, voxel, vec4(0.0));
 

@@ -81,4 +81,87 @@ vec3 projected_weights(ProjectedTriangle t, vec2 v, int i) {
     }
     return w;
 }
+// Edge line `edge` of `project_triangle` moved back onto the triangle's own edge.
+vec3 undilated(vec3 edge) {
+    return edge - vec3(0.0, 0.0, 0.5 * (abs(edge.x) + abs(edge.y)));
+}
+
+// The share of the square pixel centred at `pixel` on the inner side of the edge line
+// `line` (dot(line, (x, y, 1)) > 0): over the square, dot(line, .) is the value at its
+// centre plus two uniform spreads of widths |line.x| and |line.y|, whose sum has a
+// trapezoidal density; the share is its distribution function at the centre's value.
+float half_plane_coverage(vec3 line, vec2 pixel) {
+    float d = dot(line, vec3(pixel, 1.0));
+    float a = 0.5 * max(abs(line.x), abs(line.y));
+    float b = 0.5 * min(abs(line.x), abs(line.y));
+    if (d <= b - a) {
+        float t = max(d + a + b, 0.0);
+        return b > 0.0 ? t * t / (8.0 * a * b) : 0.0;
+    }
+    if (d >= a - b) {
+        float t = max(a + b - d, 0.0);
+        return b > 0.0 ? 1.0 - t * t / (8.0 * a * b) : 1.0;
+    }
+    return 0.5 + d / (2.0 * a);
+}
+
+// The share of the pixel centred at `pixel` that the triangle with (undilated) edge lines
+// `lines` covers: the pixel's square clipped by the three edges (Sutherland-Hodgman; at
+// most seven corners), its area by the shoelace formula. A pixel of the dilated
+// triangle's conservative coverage that the triangle only touches covers nothing.
+float pixel_coverage(vec3 lines[3], vec2 pixel) {
+    // Beyond half the square's extent across an edge, the square lies wholly on one side.
+    int crossing = 0;
+    int crossed = 0;
+    for (int e = 0; e < 3; e++) {
+        float d = dot(lines[e], vec3(pixel, 1.0));
+        float reach = 0.5 * (abs(lines[e].x) + abs(lines[e].y));
+        if (d <= -reach) {
+            return 0.0;
+        }
+        if (d < reach) {
+            crossing++;
+            crossed = e;
+        }
+    }
+    if (crossing == 0) {
+        return 1.0;
+    }
+    if (crossing == 1) {
+        return half_plane_coverage(lines[crossed], pixel);
+    }
+    vec2 poly[8];
+    poly[0] = pixel + vec2(-0.5, -0.5);
+    poly[1] = pixel + vec2(0.5, -0.5);
+    poly[2] = pixel + vec2(0.5, 0.5);
+    poly[3] = pixel + vec2(-0.5, 0.5);
+    int count = 4;
+    for (int e = 0; e < 3; e++) {
+        vec2 clipped[8];
+        int kept = 0;
+        for (int i = 0; i < count; i++) {
+            vec2 a = poly[i];
+            vec2 b = poly[(i + 1) % count];
+            float da = dot(lines[e], vec3(a, 1.0));
+            float db = dot(lines[e], vec3(b, 1.0));
+            if (da >= 0.0 && kept < 8) {
+                clipped[kept++] = a;
+            }
+            if ((da >= 0.0) != (db >= 0.0) && kept < 8) {
+                clipped[kept++] = mix(a, b, da / (da - db));
+            }
+        }
+        count = kept;
+        for (int i = 0; i < count; i++) {
+            poly[i] = clipped[i];
+        }
+    }
+    float area = 0.0;
+    for (int i = 0; i < count; i++) {
+        vec2 a = poly[i];
+        vec2 b = poly[(i + 1) % count];
+        area += a.x * b.y - a.y * b.x;
+    }
+    return clamp(0.5 * area, 0.0, 1.0);
+}
 #endif

@@ -55,6 +55,7 @@ void main() {
     if (any(lessThan(hi, lo))) {
         return;
     }
+    vec3 lines[3] = vec3[3](undilated(t.edge[0]), undilated(t.edge[1]), undilated(t.edge[2]));
     uint width = uint(hi.x - lo.x + 1);
     uint pixels = width * uint(hi.y - lo.y + 1);
     // A large triangle's pixels are shared among the workgroups along y.
@@ -68,6 +69,6 @@ void main() {
         }
         vec3 w = projected_weights(t, pixel, 0);
         cover_pixel(pixel, w.x * normal[0] + w.y * normal[1] + w.z * normal[2],
-                    w.x * uv[0] + w.y * uv[1] + w.z * uv[2], t.bounds, t.axis, t.plane, t.depth_range);
+                    w.x * uv[0] + w.y * uv[1] + w.z * uv[2], t.bounds, t.axis, t.plane, t.depth_range, lines);
     }
 }

@@ -16,6 +16,7 @@ layout(location = 3) flat out vec4 out_bounds;     // pixel-space xy min, xy max
 layout(location = 4) flat out uint out_axis;
 layout(location = 5) flat out vec3 out_plane;      // depth (voxels) = dot(plane, (x, y, 1))
 layout(location = 6) flat out vec2 out_depth_range; // triangle's depth extent in voxels
+layout(location = 7) flat out vec3 out_lines[3];    // the undilated edge lines
 
 void main() {
     ProjectedTriangle t = project_triangle(vec3[3](in_world[0], in_world[1], in_world[2]));
@@ -32,6 +33,7 @@ void main() {
         out_axis = t.axis;
         out_plane = t.plane;
         out_depth_range = t.depth_range;
+        out_lines = vec3[3](undilated(t.edge[0]), undilated(t.edge[1]), undilated(t.edge[2]));
         float depth = clamp(dot(t.plane, vec3(v, 1.0)) / n, 0.0, 1.0);
         gl_Position = vec4(v / n * 2.0 - 1.0, depth, 1.0);
         EmitVertex();

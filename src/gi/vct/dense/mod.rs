@@ -34,6 +34,8 @@ struct Volumes {
     normal: Image,
     emission: Image,
     radiance: Image,
+    /// The share of each voxel's cross-section across x, y and z that its surfaces cover.
+    coverage: Image,
     /// Direct light only, the starting point of each bounce.
     direct: Image,
     /// The fragment sums the means in `albedo`, `normal` and `emission` are taken from
@@ -64,6 +66,8 @@ fn dense_keeps_static_sums(scene: &Scene, full_update: bool) -> bool {
     scene.has_moving_meshes() && !full_update
 }
 const RADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+/// The voxels' coverage (`BINDING_VCT_COVERAGE`), dense grid and octree alike.
+pub(crate) const COVERAGE_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 
 impl Volumes {
     /// `slots`: the directional texture's volumes (`Store::directional_slots`).
@@ -112,6 +116,11 @@ impl Volumes {
                 "voxel direct",
                 ImageDesc::d3(RADIANCE_FORMAT, n, 1, radiance_usage),
             )?,
+            coverage: Image::new(
+                ctx,
+                "voxel coverage",
+                ImageDesc::d3(COVERAGE_FORMAT, n, 1, radiance_usage),
+            )?,
             directional,
         })
     }
@@ -123,6 +132,7 @@ impl Volumes {
             ("voxel_emission", self.emission.memory_bytes()),
             ("voxel_radiance", self.radiance.memory_bytes()),
             ("voxel_direct", self.direct.memory_bytes()),
+            ("voxel_coverage", self.coverage.memory_bytes()),
             (
                 "voxel_radiance_directional",
                 self.directional.memory_bytes(),
@@ -211,7 +221,14 @@ impl VoxelStore for Dense {
                 layout::BINDING_DENSE_STATIC_SUMS,
                 volumes.static_sums.as_ref().unwrap_or(&volumes.sums).view,
             );
-        bind_cone_samples(writer, &volumes.radiance, &volumes.directional, linear).apply();
+        bind_cone_samples(
+            writer,
+            &volumes.radiance,
+            &volumes.coverage,
+            &volumes.directional,
+            linear,
+        )
+        .apply();
         // The volumes start at zero, once: the compact pass zeroes the sums after taking
         // their means, and a voxel's attributes and radiance when it empties. They stay in
         // GENERAL: written as storage, the radiance sampled by cones.
@@ -223,6 +240,7 @@ impl VoxelStore for Dense {
                 &volumes.emission,
                 &volumes.radiance,
                 &volumes.direct,
+                &volumes.coverage,
             ];
             for image in zeroed {
                 clear_to_zero(
@@ -435,15 +453,15 @@ impl Dense {
             Volume::Normal => &v.normal,
             Volume::Emission => &v.emission,
             Volume::Radiance => &v.radiance,
+            Volume::Coverage => &v.coverage,
             Volume::Directional(_) => &v.directional,
         };
         // Edge of the level; the directional texture is six slots of two such cubes wide.
         let n = (image.desc.extent.height >> level).max(1);
         let width = (image.desc.extent.width >> level).max(1);
-        let texel = if image.desc.format == PACKED_FORMAT {
-            4
-        } else {
-            8
+        let texel = match image.desc.format {
+            PACKED_FORMAT | COVERAGE_FORMAT => 4,
+            _ => 8,
         };
         let any_shader = ImageUse {
             layout: vk::ImageLayout::GENERAL,
@@ -545,6 +563,8 @@ pub enum Volume {
     Emission,
     /// RGBA16F radiance, premultiplied by opacity.
     Radiance,
+    /// RGBA8 coverage across x, y and z; alpha 1 where occupied.
+    Coverage,
     /// RGBA16F directional volume +X -X +Y -Y +Z -Z (0..6).
     Directional(usize),
 }

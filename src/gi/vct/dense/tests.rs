@@ -108,6 +108,110 @@ fn voxelization_matches_cpu_on_a_rotated_thin_mesh() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The coverage volume of one frame of `scene` at `n`³ with `voxelizer` and the snapped
+/// cones: per voxel, its coverage across x, y and z.
+fn coverage(scene: Scene, n: u32, voxelizer: Voxelizer) -> (Grid, Vec<[f32; 3]>) {
+    let mut settings = with_voxelizer(gi_settings(n, DENSE, false), voxelizer);
+    // Taken only where a cone reads it: the snapped soft-shadow cones do.
+    let vct = cone_settings(&mut settings);
+    vct.cones.snapped_cones = true;
+    vct.shadow_cones = true;
+    let (ctx, renderer) = render_frames(scene, settings, &[0.0]);
+    assert_eq!(ctx.validation_messages(), 0);
+    let bytes = dense(&renderer)
+        .store()
+        .download(Volume::Coverage, 0)
+        .unwrap();
+    let texels = bytes
+        .chunks_exact(4)
+        .map(|t| [t[0], t[1], t[2]].map(|c| f32::from(c) / 255.0))
+        .collect();
+    (*dense(&renderer).grid(), texels)
+}
+
+/// A scene of `obj` alone (placed by `placement`, a scene file's mesh keys), loaded from a
+/// fresh folder named after `name`.
+fn scene_of(name: &str, obj: &str, placement: &str) -> Scene {
+    let dir = std::env::temp_dir().join(format!("voxcone-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("mesh.obj"), obj).unwrap();
+    std::fs::write(
+        dir.join("scene.toml"),
+        format!("[[mesh]]\npath = \"mesh.obj\"\n{placement}"),
+    )
+    .unwrap();
+    let scene = Scene::load(&dir.join("scene.toml"), &LoadOptions::default()).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    scene
+}
+
+/// Each voxel's coverage across an axis is the share of its cross-section that its
+/// surfaces cover, seen along the axis, with either voxelizer: a level rectangle whose
+/// edges lie inside voxels covers each voxel of its layer by the overlap of the two,
+/// exactly (to the 8-bit quantum), and nothing across the other axes, though conservative
+/// voxelization occupies every voxel its edges touch; a rectangle turned on all three
+/// axes covers, summed over the voxels, its area projected along each axis.
+#[test]
+fn coverage_is_the_covered_share_of_each_voxel() {
+    // The two small triangles at opposite corners set the grid: [-1, 1]³ and a little.
+    let corners = "v -1 -1 -1\nv -0.99 -1 -1\nv -1 -0.99 -1\nv 1 1 1\nv 0.99 1 1\nv 1 0.99 1\n\
+                   f 1 2 3\nf 4 5 6\n";
+    let (x0, x1, y, z0, z1) = (-0.313f32, 0.271, 0.137, -0.229, 0.351);
+    let level = format!(
+        "{corners}v {x0} {y} {z0}\nv {x1} {y} {z0}\nv {x1} {y} {z1}\nv {x0} {y} {z1}\nf 7 10 9 8\n"
+    );
+    let level = scene_of("coverage-level", &level, "");
+    let tilted = "v -0.65 0 -0.45\nv 0.65 0 -0.45\nv 0.65 0 0.45\nv -0.65 0 0.45\nf 1 4 3 2\n";
+    let tilted = scene_of("coverage-tilted", tilted, "rotate_deg = [23, 41, 17]\n");
+    for voxelizer in [Voxelizer::Raster, Voxelizer::Compute] {
+        let (grid, got) = coverage(level.clone(), 32, voxelizer);
+        let v = grid.voxel_size;
+        let overlap = |lo: f32, hi: f32, i: u32, origin: f32| {
+            let (a, b) = (origin + i as f32 * v, origin + (i + 1) as f32 * v);
+            ((hi.min(b) - lo.max(a)) / v).max(0.0)
+        };
+        let layer = ((y - grid.origin.y) / v) as u32;
+        let mut worst = 0.0f32;
+        for k in 0..grid.resolution {
+            for i in 0..grid.resolution {
+                let want = overlap(x0, x1, i, grid.origin.x) * overlap(z0, z1, k, grid.origin.z);
+                let c = got[grid.index(i, layer, k)];
+                worst = worst.max((c[1] - want).abs());
+                assert_eq!(
+                    [c[0], c[2]],
+                    [0.0, 0.0],
+                    "({i}, {layer}, {k}), {voxelizer:?}"
+                );
+            }
+        }
+        eprintln!("level rectangle, {voxelizer:?}: worst coverage across y off by {worst:.4}");
+        assert!(worst <= 1.0 / 255.0, "{voxelizer:?}: {worst}");
+
+        let (grid, got) = coverage(tilted.clone(), 32, voxelizer);
+        let area = reference::world_triangles(&tilted)
+            .iter()
+            .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).abs())
+            .fold(glam::Vec3::ZERO, |a, b| a + b)
+            / (grid.voxel_size * grid.voxel_size);
+        let total = got
+            .iter()
+            .fold(glam::Vec3::ZERO, |a, c| a + glam::Vec3::from(*c));
+        eprintln!(
+            "turned rectangle, {voxelizer:?}: coverage summed {total}, projected area {area}"
+        );
+        // Each fragment's share is rounded to 1/255: a small projection, made of many
+        // small shares, is off by more of itself.
+        for a in 0..3 {
+            assert!(
+                (total[a] - area[a]).abs() <= 0.01 * area.max_element(),
+                "{voxelizer:?}, axis {a}: {} against {}",
+                total[a],
+                area[a]
+            );
+        }
+    }
+}
+
 fn halves(bytes: &[u8]) -> Vec<[f32; 4]> {
     bytes
         .chunks_exact(8)

@@ -449,7 +449,7 @@ impl Octree {
             for (image, to) in attributes.chain(radiance) {
                 image_barrier(ctx, cmd, image.raw, image.full_range(), p.last_use(), to);
             }
-            for image in [&p.leaf_radiance, &p.directional] {
+            for image in [&p.leaf_radiance, &p.leaf_coverage, &p.directional] {
                 if p.in_general.get() {
                     image_barrier(
                         ctx,

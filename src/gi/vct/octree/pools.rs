@@ -8,6 +8,7 @@ use anyhow::{ensure, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
+use super::super::dense::COVERAGE_FORMAT;
 use super::super::{bind_cone_samples, Grid};
 use crate::gpu_layout::{
     self as layout, OctreeBounceDispatch, OctreeCounters, OctreeUpdateList, VoxelListHeader,
@@ -197,6 +198,8 @@ pub(super) struct Pools {
     pub(super) leaf_direct: Image,
     /// Leaf radiance (`OCTREE_RADIANCE_BRICK`³ each: the voxels and a border).
     pub(super) leaf_radiance: Image,
+    /// Leaf voxels' coverage (`BINDING_VCT_COVERAGE`), laid out as `leaf_radiance`.
+    pub(super) leaf_coverage: Image,
     /// Interior bricks' six directional radiances, and with the planes (`Store::planes`) their
     /// planes and coverage, side by side along x (`slots` of them).
     pub(super) directional: Image,
@@ -344,6 +347,12 @@ impl Pools {
                 leaf_side * layout::OCTREE_RADIANCE_BRICK,
                 true,
             )?,
+            leaf_coverage: image(
+                "octree leaf coverage",
+                COVERAGE_FORMAT,
+                leaf_side * layout::OCTREE_RADIANCE_BRICK,
+                true,
+            )?,
             directional: Image::new(ctx, "octree interior radiance", directional_desc)?,
             slots,
             voxel_list: buffer(
@@ -441,7 +450,14 @@ impl Pools {
                 layout::BINDING_OCTREE_DIRECTIONAL_STORAGE,
                 self.directional.view,
             );
-        bind_cone_samples(writer, &self.leaf_radiance, &self.directional, linear).apply();
+        bind_cone_samples(
+            writer,
+            &self.leaf_radiance,
+            &self.leaf_coverage,
+            &self.directional,
+            linear,
+        )
+        .apply();
     }
 
     /// The state of the images before a build: new (the first time), or whatever any
@@ -462,7 +478,12 @@ impl Pools {
         let bricks: u64 = self
             .leaf_attributes
             .iter()
-            .chain([&self.leaf_direct, &self.leaf_radiance, &self.directional])
+            .chain([
+                &self.leaf_direct,
+                &self.leaf_radiance,
+                &self.leaf_coverage,
+                &self.directional,
+            ])
             .map(Image::memory_bytes)
             .sum();
         vec![

@@ -10,6 +10,8 @@
 #include "gi/vct/octree/nodes/level.glsl"
 
 layout(set = SET_GI, binding = BINDING_VCT_RADIANCE, rgba16f) uniform image3D leaf_radiance;
+// The leaves' coverage shares their radiance's bricks and borders.
+layout(set = SET_GI, binding = BINDING_VCT_COVERAGE, rgba8) uniform image3D leaf_coverage;
 layout(set = SET_GI, binding = BINDING_OCTREE_DIRECTIONAL_STORAGE, rgba16f) uniform image3D directional;
 
 void main() {
@@ -36,6 +38,8 @@ void main() {
         if (leaf) {
             vec4 value = brick == OCTREE_NO_BRICK ? vec4(0.0) : imageLoad(leaf_radiance, from);
             imageStore(leaf_radiance, origin + t, value);
+            vec4 coverage = brick == OCTREE_NO_BRICK ? vec4(0.0) : imageLoad(leaf_coverage, from);
+            imageStore(leaf_coverage, origin + t, coverage);
         } else {
             for (int d = 0; d < int(directional_slots()); d++) {
                 ivec3 shift = ivec3(d * direction_stride, 0, 0);

@@ -1,7 +1,8 @@
 #version 460
 // Per leaf: each voxel's fragment sums (fill.comp) become its mean albedo, normal and
 // emission in the leaf attribute bricks (RGBA8, alpha the fragment count up to 255, as
-// the dense grid stores them; zero for a voxel without fragments), and the occupied
+// the dense grid stores them; zero for a voxel without fragments) and its coverage in
+// the leaf coverage bricks (laid out as the radiance bricks, whose borders it shares), and the occupied
 // voxels are listed with their leaf's brick, so that voxel shading and bounces run one
 // invocation per voxel, dispatched indirectly from the list's head as in the dense grid
 // (gi/vct/dense/compact.comp). Bricks of the static part (before
@@ -22,6 +23,7 @@ layout(set = SET_GI, binding = BINDING_VCT_ALBEDO, r32ui) uniform writeonly uima
 layout(set = SET_GI, binding = BINDING_VCT_NORMAL, r32ui) uniform writeonly uimage3D leaf_normal;
 layout(set = SET_GI, binding = BINDING_VCT_EMISSION, r32ui) uniform writeonly uimage3D leaf_emission;
 layout(set = SET_GI, binding = BINDING_VCT_RADIANCE, rgba16f) uniform writeonly image3D leaf_radiance;
+layout(set = SET_GI, binding = BINDING_VCT_COVERAGE, rgba8) uniform writeonly image3D leaf_coverage;
 
 // Writes the means of `node`'s voxels into a brick given in this build or frame (and
 // zeroes their radiance); returns the mask of its voxels with fragments.
@@ -43,15 +45,19 @@ uint take_means(uint node) {
         if (!fresh) {
             continue;
         }
+        uvec3 sums[4] = uvec3[4](uvec3(0u), uvec3(0u), uvec3(0u), uvec3(0u));
+        for (uint a = 0u; a < (VOXEL_COVERAGE ? 4u : 3u); a++) {
+            sums[a] = uvec3(leaf_sums[base + 3u * a], leaf_sums[base + 3u * a + 1u], leaf_sums[base + 3u * a + 2u]);
+        }
         uint means[3];
         for (uint a = 0u; a < 3u; a++) {
-            uvec3 sum = uvec3(leaf_sums[base + 3u * a], leaf_sums[base + 3u * a + 1u], leaf_sums[base + 3u * a + 2u]);
-            means[a] = packed_mean(sum, count);
+            means[a] = packed_mean(sums[a], count);
         }
         imageStore(leaf_albedo, origin + k, uvec4(means[0]));
         imageStore(leaf_normal, origin + k, uvec4(means[1]));
         imageStore(leaf_emission, origin + k, uvec4(means[2]));
         imageStore(leaf_radiance, radiance_origin + k, vec4(0.0));
+        imageStore(leaf_coverage, radiance_origin + k, coverage_of(sums[3], count));
     }
     return listed;
 }

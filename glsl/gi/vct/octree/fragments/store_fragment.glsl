@@ -22,15 +22,17 @@ uint append_fragment() {
 }
 #endif
 
-void store_voxel(ivec3 voxel, vec3 albedo, vec3 normal, vec3 emission) {
+// The coverage across x, y and z rides in the alpha of the albedo, normal and emission.
+void store_voxel(ivec3 voxel, vec3 albedo, vec3 normal, vec3 emission, vec3 coverage) {
     uint index = append_fragment();
     if (index >= counters.fragment_capacity) {
         atomicOr(counters.overflow, OCTREE_OVERFLOW_FRAGMENTS);
         return;
     }
     fragment_voxels[index] = pack_coord(uvec3(voxel));
-    fragment_voxels[counters.fragment_capacity + index] = pack_rgba8(vec4(albedo * 255.0, 255.0));
-    fragment_shading[index] = uvec2(pack_rgba8(vec4(normal * 255.0, 255.0)), pack_rgba8(vec4(emission * 255.0, 255.0)));
+    vec3 c = clamp(coverage, 0.0, 1.0) * 255.0;
+    fragment_voxels[counters.fragment_capacity + index] = pack_rgba8(vec4(albedo * 255.0, c.x));
+    fragment_shading[index] = uvec2(pack_rgba8(vec4(normal * 255.0, c.y)), pack_rgba8(vec4(emission * 255.0, c.z)));
     uint read = index - counters.fragment_base;
     if (read % OCTREE_GROUP_SIZE == 0u) {
         atomicMax(counters.fragment_groups_x, read / OCTREE_GROUP_SIZE + 1u);
