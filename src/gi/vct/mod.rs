@@ -30,8 +30,8 @@ pub use self::dense::Dense;
 pub use self::grid::Grid;
 pub use self::octree::Octree;
 pub use self::settings::{
-    auto_indirect_scale, auto_voxels, check_voxel_size, check_voxels, ConeSettings,
-    DirectionalFilter, Quality, Resolution, Store, VctSettings, CPU_VOXELS,
+    auto_indirect_scale, auto_voxels, check_voxel_size, check_voxels, dense_bytes_per_voxel,
+    ConeSettings, DirectionalFilter, Quality, Resolution, Store, VctSettings, CPU_VOXELS,
     DEFAULT_SAMPLED_EMITTERS, EMITTER_PIECES, LATTICE_CONES, MOST_VOXELS,
 };
 use super::{

@@ -105,7 +105,8 @@ impl Resolution {
                 let memory = (!ctx.is_cpu() || quality == Quality::Accurate)
                     .then(|| ctx.device_local_bytes());
                 let extent = Grid::extent_around(scene);
-                let count = auto_voxels(memory, extent, size, cones.snapped_cones);
+                let bytes = dense_bytes_per_voxel(scene.has_moving_meshes());
+                let count = auto_voxels(memory, bytes, extent, size, cones.snapped_cones);
                 let device = match (ctx.is_cpu(), quality) {
                     (false, _) => "a GPU",
                     (true, Quality::Fast) => "a CPU driver in real time",
@@ -153,27 +154,47 @@ pub const LATTICE_CONES: u32 = 72;
 /// and renders a reference scene in 27 to 86 s on lavapipe with the lattice; 512³ has
 /// eight times the voxels and 16 GiB of grid.
 pub const MOST_VOXELS: u32 = 256;
-/// The dense grid's bytes per voxel, volumes, their mips and the fragment sums, the
-/// static meshes' too (`bench`'s `memory_mib`: 2011 MiB at 256³ before the voxels'
-/// coverage, session 47, which adds 4 bytes and 16 to each sums image: 2592 MiB).
-const BYTES_PER_VOXEL: u64 = 162;
+/// The dense grid's bytes per voxel: volumes, their mips and the fragment sums (`bench`'s
+/// `memory_mib`; 1376 MiB at 256³ before the voxels' coverage, session 47, which adds 4
+/// bytes and 16 to the sums: 1696 MiB).
+const BYTES_PER_VOXEL: u64 = 106;
+/// The static meshes' copy of the fragment sums, with moving meshes
+/// (`dense_keeps_static_sums`).
+const STATIC_SUMS_BYTES_PER_VOXEL: u64 = 56;
+
+/// The dense grid's bytes per voxel for a scene with or without `moving_meshes`.
+pub fn dense_bytes_per_voxel(moving_meshes: bool) -> u64 {
+    BYTES_PER_VOXEL
+        + if moving_meshes {
+            STATIC_SUMS_BYTES_PER_VOXEL
+        } else {
+            0
+        }
+}
 
 /// Voxels per axis when none are given.
 /// - The device sets the most: [`CPU_VOXELS`] on a CPU driver in real time (`memory` is
 ///   `None`); on a GPU, or for one image ([`Quality::Accurate`]), [`MOST_VOXELS`], halved
-///   while the grid would take more than a quarter of the device-local `memory` (bytes).
+///   while the grid, of `bytes_per_voxel` ([`dense_bytes_per_voxel`]), would take more
+///   than a quarter of the device-local `memory` (bytes).
 /// - A wanted voxel `size` (in the units of the scene's `extent`) takes the least power of
 ///   two whose voxels are no larger, from [`CPU_VOXELS`] to that most.
 /// - Without one, the most where finer voxels give a better image (`finer_helps`: the
 ///   snapped cones, whose error falls from 64³ to 256³ on four of the five references),
 ///   else [`CPU_VOXELS`]: the default cones are tuned there, and three of the five
 ///   references get worse at 256³ (BENCHMARKS.md, "The default resolution").
-pub fn auto_voxels(memory: Option<u64>, extent: f32, size: Option<f32>, finer_helps: bool) -> u32 {
+pub fn auto_voxels(
+    memory: Option<u64>,
+    bytes_per_voxel: u64,
+    extent: f32,
+    size: Option<f32>,
+    finer_helps: bool,
+) -> u32 {
     let most = match memory {
         None => CPU_VOXELS,
         Some(bytes) => {
             let mut most = MOST_VOXELS;
-            while most > CPU_VOXELS && u64::from(most).pow(3) * BYTES_PER_VOXEL > bytes / 4 {
+            while most > CPU_VOXELS && u64::from(most).pow(3) * bytes_per_voxel > bytes / 4 {
                 most /= 2;
             }
             most
@@ -421,31 +442,57 @@ mod tests {
     use super::*;
 
     const GIB: u64 = 1 << 30;
+    const MOVING: u64 = BYTES_PER_VOXEL + STATIC_SUMS_BYTES_PER_VOXEL;
+    const STILL: u64 = BYTES_PER_VOXEL;
 
     /// The rule: the device's most, fewer for a short memory or a large wanted voxel,
     /// never under the CPU's; 64³ for the default cones unless a size is wanted.
     #[test]
     fn default_resolution_follows_the_device_and_the_scene() {
         // A CPU driver in real time: 64³ whatever the wanted size.
-        assert_eq!(auto_voxels(None, 10.0, None, true), CPU_VOXELS);
-        assert_eq!(auto_voxels(None, 10.0, Some(0.001), true), CPU_VOXELS);
-        // A GPU, or one image, with 80 GiB: 256³ (2.5 GiB of grid); with 4 GiB, a quarter
-        // is 1 GiB: 128³.
-        assert_eq!(auto_voxels(Some(80 * GIB), 10.0, None, true), MOST_VOXELS);
-        assert_eq!(auto_voxels(Some(4 * GIB), 10.0, None, true), 128);
-        assert_eq!(auto_voxels(Some(GIB / 4), 10.0, None, true), CPU_VOXELS);
-        // Without a wanted size the default cones keep 64³ on every device.
-        assert_eq!(auto_voxels(Some(80 * GIB), 10.0, None, false), CPU_VOXELS);
-        // A wanted size: the least power of two whose voxels are no larger.
-        assert_eq!(auto_voxels(Some(80 * GIB), 10.0, Some(0.1), false), 128);
-        assert_eq!(auto_voxels(Some(80 * GIB), 12.8, Some(0.1), false), 128);
-        assert_eq!(auto_voxels(Some(80 * GIB), 12.81, Some(0.1), false), 256);
+        assert_eq!(auto_voxels(None, MOVING, 10.0, None, true), CPU_VOXELS);
         assert_eq!(
-            auto_voxels(Some(80 * GIB), 10.0, Some(5.0), false),
+            auto_voxels(None, MOVING, 10.0, Some(0.001), true),
+            CPU_VOXELS
+        );
+        // A GPU, or one image, with 80 GiB: 256³ (2.5 GiB of grid with moving meshes); with
+        // 4 GiB, a quarter is 1 GiB: 128³; with 8 GiB, 256³ without moving meshes (1.7 GiB)
+        // and 128³ with them (2.5 GiB).
+        assert_eq!(
+            auto_voxels(Some(80 * GIB), MOVING, 10.0, None, true),
+            MOST_VOXELS
+        );
+        assert_eq!(auto_voxels(Some(4 * GIB), MOVING, 10.0, None, true), 128);
+        assert_eq!(auto_voxels(Some(8 * GIB), STILL, 10.0, None, true), 256);
+        assert_eq!(auto_voxels(Some(8 * GIB), MOVING, 10.0, None, true), 128);
+        assert_eq!(
+            auto_voxels(Some(GIB / 4), MOVING, 10.0, None, true),
+            CPU_VOXELS
+        );
+        // Without a wanted size the default cones keep 64³ on every device.
+        assert_eq!(
+            auto_voxels(Some(80 * GIB), MOVING, 10.0, None, false),
+            CPU_VOXELS
+        );
+        // A wanted size: the least power of two whose voxels are no larger.
+        assert_eq!(
+            auto_voxels(Some(80 * GIB), MOVING, 10.0, Some(0.1), false),
+            128
+        );
+        assert_eq!(
+            auto_voxels(Some(80 * GIB), MOVING, 12.8, Some(0.1), false),
+            128
+        );
+        assert_eq!(
+            auto_voxels(Some(80 * GIB), MOVING, 12.81, Some(0.1), false),
+            256
+        );
+        assert_eq!(
+            auto_voxels(Some(80 * GIB), MOVING, 10.0, Some(5.0), false),
             CPU_VOXELS
         );
         assert_eq!(
-            auto_voxels(Some(80 * GIB), 1e30, Some(1e-30), false),
+            auto_voxels(Some(80 * GIB), MOVING, 1e30, Some(1e-30), false),
             MOST_VOXELS
         );
     }

@@ -6,8 +6,8 @@ use std::sync::Arc;
 use super::super::reference;
 use super::super::voxelize::Voxelizer;
 use super::super::{
-    auto_voxels, ConeSettings, DirectionalFilter, Grid, Quality, Resolution, Store, CPU_VOXELS,
-    LATTICE_CONES,
+    auto_voxels, dense_bytes_per_voxel, ConeSettings, DirectionalFilter, Grid, Quality, Resolution,
+    Store, CPU_VOXELS, LATTICE_CONES,
 };
 use super::Volume;
 use crate::gi::bounces::converged_bounces;
@@ -594,7 +594,10 @@ fn the_default_resolution_reaches_the_grid() {
         assert!(ctx.is_cpu(), "the rule's GPU branch is tested on its own");
         let want = match quality {
             Quality::Fast => CPU_VOXELS,
-            Quality::Accurate => auto_voxels(Some(ctx.device_local_bytes()), extent, size, true),
+            Quality::Accurate => {
+                let bytes = dense_bytes_per_voxel(scene.has_moving_meshes());
+                auto_voxels(Some(ctx.device_local_bytes()), bytes, extent, size, true)
+            }
         };
         let GiSettings::ConeTracing(kept) = &renderer.settings.gi else {
             panic!("no cone tracing");
