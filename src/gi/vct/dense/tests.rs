@@ -88,24 +88,15 @@ fn voxelization_matches_cpu_on_cornell_box() {
 
 #[test]
 fn voxelization_matches_cpu_on_a_rotated_thin_mesh() {
-    let dir = std::env::temp_dir().join(format!("voxcone-thin-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
     // A 2 x 0.02 x 1.3 slab, thinner than a voxel, tilted on all three axes, inside a
     // unit box that sets the grid's extent.
     let obj = "v -1 -0.01 -0.65\nv 1 -0.01 -0.65\nv 1 0.01 -0.65\nv -1 0.01 -0.65\n\
                v -1 -0.01 0.65\nv 1 -0.01 0.65\nv 1 0.01 0.65\nv -1 0.01 0.65\n\
                f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n";
-    std::fs::write(dir.join("slab.obj"), obj).unwrap();
-    std::fs::write(
-        dir.join("scene.toml"),
-        "[[mesh]]\npath = \"slab.obj\"\nrotate_deg = [23, 41, 17]\n",
-    )
-    .unwrap();
-    let scene = Scene::load(&dir.join("scene.toml"), &LoadOptions::default()).unwrap();
+    let scene = scene_of("thin", obj, "rotate_deg = [23, 41, 17]\n");
     for n in [32, 64] {
         check_voxelization(scene.clone(), n);
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The coverage volume of one frame of `scene` at `n`³ with `voxelizer` and the snapped

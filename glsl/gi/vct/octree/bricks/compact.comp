@@ -2,9 +2,9 @@
 // Per leaf: each voxel's fragment sums (fill.comp) become its mean albedo, normal and
 // emission in the leaf attribute bricks (RGBA8, alpha the fragment count up to 255, as
 // the dense grid stores them; zero for a voxel without fragments) and its coverage in
-// the leaf coverage bricks (laid out as the radiance bricks, whose borders it shares), and the occupied
-// voxels are listed with their leaf's brick, so that voxel shading and bounces run one
-// invocation per voxel, dispatched indirectly from the list's head as in the dense grid
+// the leaf coverage bricks (laid out as the radiance bricks, whose borders it shares),
+// and the occupied voxels are listed with their leaf's brick, so that voxel shading and
+// bounces run one invocation per voxel, dispatched indirectly from the list's head as in the dense grid
 // (gi/vct/dense/compact.comp). Bricks of the static part (before
 // `counters.static_leaf_bricks`) keep the attributes their build wrote; later ones, given
 // in this build or frame (every brick, in a build), are written, and their radiance

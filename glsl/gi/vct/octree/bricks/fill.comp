@@ -1,6 +1,7 @@
 #version 460
 // Each voxel fragment adds its albedo, normal, emission and coverage (0..255 per channel;
-// the coverage in the alpha of the other three) and a count to its voxel's sums (Dřínovský 2013, 5.4.1). Integer atomic adds are exact and
+// the coverage in the alpha of the other three, where it is taken: VOXEL_COVERAGE) and a
+// count to its voxel's sums (Dřínovský 2013, 5.4.1). Integer atomic adds are exact and
 // commutative, so the averages that compact.comp takes do not depend on the order in
 // which the fragments were listed (a running average would, and the list's order
 // changes from build to build). A leaf brick holds the leaf's 2x2x2 voxels of the
@@ -35,7 +36,9 @@ void main() {
         for (uint c = 0u; c < 3u; c++) {
             atomicAdd(leaf_sums[base + 3u * a + c], (words[a] >> (8u * c)) & 0xffu);
         }
-        atomicAdd(leaf_sums[base + SUM_COVERAGE + a], words[a] >> 24u);
+        if (VOXEL_COVERAGE) {
+            atomicAdd(leaf_sums[base + SUM_COVERAGE + a], words[a] >> 24u);
+        }
     }
     atomicAdd(leaf_sums[base + SUM_COUNT], 1u);
 }
