@@ -164,12 +164,7 @@ const STATIC_SUMS_BYTES_PER_VOXEL: u64 = 56;
 
 /// The dense grid's bytes per voxel for a scene with or without `moving_meshes`.
 pub fn dense_bytes_per_voxel(moving_meshes: bool) -> u64 {
-    BYTES_PER_VOXEL
-        + if moving_meshes {
-            STATIC_SUMS_BYTES_PER_VOXEL
-        } else {
-            0
-        }
+    BYTES_PER_VOXEL + u64::from(moving_meshes) * STATIC_SUMS_BYTES_PER_VOXEL
 }
 
 /// Voxels per axis when none are given.
@@ -442,57 +437,56 @@ mod tests {
     use super::*;
 
     const GIB: u64 = 1 << 30;
-    const MOVING: u64 = BYTES_PER_VOXEL + STATIC_SUMS_BYTES_PER_VOXEL;
-    const STILL: u64 = BYTES_PER_VOXEL;
 
     /// The rule: the device's most, fewer for a short memory or a large wanted voxel,
     /// never under the CPU's; 64³ for the default cones unless a size is wanted.
     #[test]
     fn default_resolution_follows_the_device_and_the_scene() {
+        let (moving, still) = (dense_bytes_per_voxel(true), dense_bytes_per_voxel(false));
         // A CPU driver in real time: 64³ whatever the wanted size.
-        assert_eq!(auto_voxels(None, MOVING, 10.0, None, true), CPU_VOXELS);
+        assert_eq!(auto_voxels(None, moving, 10.0, None, true), CPU_VOXELS);
         assert_eq!(
-            auto_voxels(None, MOVING, 10.0, Some(0.001), true),
+            auto_voxels(None, moving, 10.0, Some(0.001), true),
             CPU_VOXELS
         );
         // A GPU, or one image, with 80 GiB: 256³ (2.5 GiB of grid with moving meshes); with
         // 4 GiB, a quarter is 1 GiB: 128³; with 8 GiB, 256³ without moving meshes (1.7 GiB)
         // and 128³ with them (2.5 GiB).
         assert_eq!(
-            auto_voxels(Some(80 * GIB), MOVING, 10.0, None, true),
+            auto_voxels(Some(80 * GIB), moving, 10.0, None, true),
             MOST_VOXELS
         );
-        assert_eq!(auto_voxels(Some(4 * GIB), MOVING, 10.0, None, true), 128);
-        assert_eq!(auto_voxels(Some(8 * GIB), STILL, 10.0, None, true), 256);
-        assert_eq!(auto_voxels(Some(8 * GIB), MOVING, 10.0, None, true), 128);
+        assert_eq!(auto_voxels(Some(4 * GIB), moving, 10.0, None, true), 128);
+        assert_eq!(auto_voxels(Some(8 * GIB), still, 10.0, None, true), 256);
+        assert_eq!(auto_voxels(Some(8 * GIB), moving, 10.0, None, true), 128);
         assert_eq!(
-            auto_voxels(Some(GIB / 4), MOVING, 10.0, None, true),
+            auto_voxels(Some(GIB / 4), moving, 10.0, None, true),
             CPU_VOXELS
         );
         // Without a wanted size the default cones keep 64³ on every device.
         assert_eq!(
-            auto_voxels(Some(80 * GIB), MOVING, 10.0, None, false),
+            auto_voxels(Some(80 * GIB), moving, 10.0, None, false),
             CPU_VOXELS
         );
         // A wanted size: the least power of two whose voxels are no larger.
         assert_eq!(
-            auto_voxels(Some(80 * GIB), MOVING, 10.0, Some(0.1), false),
+            auto_voxels(Some(80 * GIB), moving, 10.0, Some(0.1), false),
             128
         );
         assert_eq!(
-            auto_voxels(Some(80 * GIB), MOVING, 12.8, Some(0.1), false),
+            auto_voxels(Some(80 * GIB), moving, 12.8, Some(0.1), false),
             128
         );
         assert_eq!(
-            auto_voxels(Some(80 * GIB), MOVING, 12.81, Some(0.1), false),
+            auto_voxels(Some(80 * GIB), moving, 12.81, Some(0.1), false),
             256
         );
         assert_eq!(
-            auto_voxels(Some(80 * GIB), MOVING, 10.0, Some(5.0), false),
+            auto_voxels(Some(80 * GIB), moving, 10.0, Some(5.0), false),
             CPU_VOXELS
         );
         assert_eq!(
-            auto_voxels(Some(80 * GIB), MOVING, 1e30, Some(1e-30), false),
+            auto_voxels(Some(80 * GIB), moving, 1e30, Some(1e-30), false),
             MOST_VOXELS
         );
     }
