@@ -50,7 +50,7 @@ impl GiSettings {
     pub fn on(&self, ctx: &Context, scene: &Scene) -> Self {
         match self {
             GiSettings::ConeTracing(vct) => GiSettings::ConeTracing(vct::VctSettings {
-                voxels: vct::Resolution::Count(vct.voxels.on(ctx, scene, &vct.cones)),
+                voxels: vct::Resolution::Count(vct.voxels.on(ctx, scene, vct)),
                 cones: vct::ConeSettings {
                     bounces: if vct.converge_bounces {
                         bounces::bounces_for(scene)

@@ -31,8 +31,8 @@ pub use self::grid::Grid;
 pub use self::octree::Octree;
 pub use self::settings::{
     auto_indirect_scale, auto_voxels, check_voxel_size, check_voxels, dense_bytes_per_voxel,
-    ConeSettings, DirectionalFilter, Quality, Resolution, Store, VctSettings, CPU_VOXELS,
-    DEFAULT_SAMPLED_EMITTERS, EMITTER_PIECES, LATTICE_CONES, MOST_VOXELS,
+    dense_keeps_static_sums, ConeSettings, DirectionalFilter, Quality, Resolution, Store,
+    VctSettings, CPU_VOXELS, DEFAULT_SAMPLED_EMITTERS, EMITTER_PIECES, LATTICE_CONES, MOST_VOXELS,
 };
 use super::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
@@ -381,7 +381,7 @@ impl<S: VoxelStore> ConeTracing<S> {
             set_layouts,
             frames_in_flight,
         } = *inputs;
-        let resolution = settings.voxels.on(ctx, scene, &settings.cones);
+        let resolution = settings.voxels.on(ctx, scene, settings);
         let cones = settings.cones;
         check_voxels(resolution)?;
         let rasterized = settings.voxelizer.on(ctx) == voxelize::Voxelizer::Raster;

@@ -95,9 +95,10 @@ pub enum Resolution {
 }
 
 impl Resolution {
-    /// The count, the rule applied for the device, the scene and the `cones` if it was
-    /// not given.
-    pub fn on(self, ctx: &Context, scene: &Scene, cones: &ConeSettings) -> u32 {
+    /// The count, the rule applied for the device, the scene and the `settings` (their
+    /// cones, and whether the grid keeps the static sums) if it was not given.
+    pub fn on(self, ctx: &Context, scene: &Scene, settings: &VctSettings) -> u32 {
+        let cones = &settings.cones;
         match self {
             Self::Count(count) => count,
             Self::Auto { size, quality } => {
@@ -105,7 +106,8 @@ impl Resolution {
                 let memory = (!ctx.is_cpu() || quality == Quality::Accurate)
                     .then(|| ctx.device_local_bytes());
                 let extent = Grid::extent_around(scene);
-                let bytes = dense_bytes_per_voxel(scene.has_moving_meshes());
+                let bytes =
+                    dense_bytes_per_voxel(dense_keeps_static_sums(scene, settings.full_update));
                 let count = auto_voxels(memory, bytes, extent, size, cones.snapped_cones);
                 let device = match (ctx.is_cpu(), quality) {
                     (false, _) => "a GPU",
@@ -158,13 +160,20 @@ pub const MOST_VOXELS: u32 = 256;
 /// `memory_mib`; 1376 MiB at 256³ before the voxels' coverage, session 47, which adds 4
 /// bytes and 16 to the sums: 1696 MiB).
 const BYTES_PER_VOXEL: u64 = 106;
-/// The static meshes' copy of the fragment sums, with moving meshes
-/// (`dense_keeps_static_sums`).
+/// The static meshes' copy of the fragment sums ([`dense_keeps_static_sums`]).
 const STATIC_SUMS_BYTES_PER_VOXEL: u64 = 56;
 
-/// The dense grid's bytes per voxel for a scene with or without `moving_meshes`.
-pub fn dense_bytes_per_voxel(moving_meshes: bool) -> u64 {
-    BYTES_PER_VOXEL + u64::from(moving_meshes) * STATIC_SUMS_BYTES_PER_VOXEL
+/// The dense grid keeps the static meshes' fragment sums apart, and voxelizes only the
+/// moving meshes every frame, when the scene has moving meshes and not every frame
+/// re-voxelizes everything (`full_update`).
+pub fn dense_keeps_static_sums(scene: &Scene, full_update: bool) -> bool {
+    scene.has_moving_meshes() && !full_update
+}
+
+/// The dense grid's bytes per voxel, with or without the copy of the `static_sums`
+/// ([`dense_keeps_static_sums`]).
+pub fn dense_bytes_per_voxel(static_sums: bool) -> u64 {
+    BYTES_PER_VOXEL + u64::from(static_sums) * STATIC_SUMS_BYTES_PER_VOXEL
 }
 
 /// Voxels per axis when none are given.

@@ -15,8 +15,8 @@ use ash::vk;
 
 use super::voxelize::{self, Meshes, VoxelizePass};
 use super::{
-    bind_cone_samples, directional_levels, DirectionalFilter, Grid, PipelineBase, Preparation,
-    Store, StoreShaders, VctSettings, VoxelStore, Voxels,
+    bind_cone_samples, dense_keeps_static_sums, directional_levels, DirectionalFilter, Grid,
+    PipelineBase, Preparation, Store, StoreShaders, VctSettings, VoxelStore, Voxels,
 };
 use crate::gi::DebugView;
 use crate::gpu_layout::{self as layout, InjectPush};
@@ -59,12 +59,6 @@ struct Volumes {
 const DIRECTIONAL_SLOT: u32 = 2;
 
 const PACKED_FORMAT: vk::Format = vk::Format::R32_UINT;
-/// The dense grid keeps the static meshes' fragment sums apart, and voxelizes only the
-/// moving meshes every frame, when the scene has moving meshes and not every frame
-/// re-voxelizes everything.
-fn dense_keeps_static_sums(scene: &Scene, full_update: bool) -> bool {
-    scene.has_moving_meshes() && !full_update
-}
 const RADIANCE_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// The voxels' coverage (`BINDING_VCT_COVERAGE`), dense grid and octree alike.
 pub(crate) const COVERAGE_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;

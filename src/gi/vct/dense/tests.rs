@@ -6,8 +6,8 @@ use std::sync::Arc;
 use super::super::reference;
 use super::super::voxelize::Voxelizer;
 use super::super::{
-    auto_voxels, dense_bytes_per_voxel, ConeSettings, DirectionalFilter, Grid, Quality, Resolution,
-    Store, CPU_VOXELS, LATTICE_CONES,
+    auto_voxels, dense_bytes_per_voxel, dense_keeps_static_sums, ConeSettings, DirectionalFilter,
+    Grid, Quality, Resolution, Store, CPU_VOXELS, LATTICE_CONES,
 };
 use super::Volume;
 use crate::gi::bounces::converged_bounces;
@@ -586,7 +586,7 @@ fn the_default_resolution_reaches_the_grid() {
         let want = match quality {
             Quality::Fast => CPU_VOXELS,
             Quality::Accurate => {
-                let bytes = dense_bytes_per_voxel(scene.has_moving_meshes());
+                let bytes = dense_bytes_per_voxel(dense_keeps_static_sums(&scene, false));
                 auto_voxels(Some(ctx.device_local_bytes()), bytes, extent, size, true)
             }
         };
