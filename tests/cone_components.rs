@@ -761,9 +761,10 @@ fn canyon(dir: &Path, height: f32) -> PathBuf {
 /// one, two and four times the floor's width high, at 64³, 128³ and 256³ with `render`'s
 /// cones. Low walls let too much sky in and deep ones too little, both less at 256³ than
 /// at 64³: the deepest gathers 0.81 of the sky it sees at 64³ (0.45 when the test was
-/// written, session 38). A likely cause, not taken apart: the walls stop the same rays of a rising
-/// cone all the way up, where the march composites their share of its disc in cell after
-/// cell. Sponza's sunlit floor gathers 0.30 to 0.45 of its sky (BENCHMARKS.md, session 38).
+/// written, session 38). A likely cause, not taken apart: the walls stop the same rays of
+/// a rising cone all the way up, where the march composites their share of its disc in
+/// cell after cell. Sponza's sunlit floor gathers 0.30 to 0.45 of its sky (BENCHMARKS.md,
+/// session 38).
 #[test]
 #[ignore = "issue 20: walls half the width high 1.22 / 1.15 / 1.09 of the path tracer's at 64³ / 128³ / 256³, four times 0.81 / 0.75 / 0.80"]
 fn canyon_floor_gathers_the_sky_it_sees() {

@@ -169,6 +169,10 @@ float composite(vec4 s, float footprints, vec2 limit, float least, vec3 beyond, 
     return a;
 }
 
+// The least opacity at which a cell shows its plane's colour (s.rgb / s.a) well enough
+// for a held plane to take it (plane_increment, march_cells).
+const float PLANE_SHOWN = 0.05;
+
 // A surface plane a snapped cone has met (PLANE_OCCLUSION, plane_increment): xyz its
 // normal and w its constant (in grid units less 0.5), the share of the cone's disc
 // counted as blocked by it so far, its radiance as the cone saw it, and whether the
@@ -223,10 +227,10 @@ vec3 plane_increment(vec3 uvw, float level, vec3 axis, vec3 origin, vec3 dir, fl
         // A plane met for the first time is composited as it is (nothing before blocked
         // the same rays), and what it blocks is held for the cells after.
         // A crossed plane stays held: the rest of its rays still meet it.
-        // A plane is held from a cell that shows it (opacity over 0.05), whose colour the
+        // A plane is held from a cell that shows it (PLANE_SHOWN), whose colour the
         // rays that meet it further on take (march_cells): held where it barely showed,
         // its colour was unknown, and they took black.
-        if (planarity <= 0.5 || held.crossed || opacity <= 0.05) {
+        if (planarity <= 0.5 || held.crossed || opacity <= PLANE_SHOWN) {
             return vec3(1.0, 0.0, 0.0);
         }
         held = HeldPlane(plane, 0.0, vec3(0.0), crossing);
@@ -355,7 +359,7 @@ vec4 march_cells(vec3 origin, vec3 dir, float tan_half, float min_lod, vec3 surf
             // very cell. Read after compositing, that first stop was black: in a world
             // of uniform radiance the cones gathered 0.989 of it
             // (`uniform_world_gathers_its_radiance_whatever_the_cones_cross`).
-            if (limit.z > 0.0 && s.a > 0.05) {
+            if (limit.z > 0.0 && s.a > PLANE_SHOWN) {
                 held.radiance = s.rgb / s.a;
             }
             if (held.crossed) {

@@ -580,13 +580,14 @@ fn the_default_resolution_reaches_the_grid() {
             vct.cones.snapped_cones = true;
         }
         vct.cones.bounces = 1;
+        let full_update = vct.full_update;
         let (ctx, renderer) = render_frames(scene.clone(), settings, &[0.0]);
         assert_eq!(ctx.validation_messages(), 0);
         assert!(ctx.is_cpu(), "the rule's GPU branch is tested on its own");
         let want = match quality {
             Quality::Fast => CPU_VOXELS,
             Quality::Accurate => {
-                let bytes = dense_bytes_per_voxel(dense_keeps_static_sums(&scene, false));
+                let bytes = dense_bytes_per_voxel(dense_keeps_static_sums(&scene, full_update));
                 auto_voxels(Some(ctx.device_local_bytes()), bytes, extent, size, true)
             }
         };
