@@ -4,7 +4,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{stderr, temp_dir, voxcone};
+use common::{stderr, temp_dir, voxcone, TEST_VOXELS};
 
 fn assert_fails_naming(args: &[&str], needles: &[&str]) {
     let output = voxcone(args);
@@ -883,6 +883,9 @@ fn corpus_ends_in_an_error_or_a_finite_image() {
         ];
         if !case.options.contains(&"--size") {
             args.extend(["--size", "16x16"]);
+        }
+        if case.options.is_empty() {
+            args.extend(["--voxels", TEST_VOXELS]);
         }
         args.extend_from_slice(case.options);
         let output = voxcone(&args);

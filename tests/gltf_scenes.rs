@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{render, render_path, shared, temp_dir};
+use common::{render, render_path, shared, temp_dir, TEST_VOXELS};
 use voxcone::compare::{compare, CompareOptions};
 use voxcone::imageio::load_rgb;
 
@@ -21,7 +21,7 @@ fn cornell_point_gltf_renders_as_the_obj() {
     let reference = shared.join("reference/cornell_point.exr");
     let dir = temp_dir("gltf_cornell");
     let (from_gltf, from_obj) = (dir.join("gltf.exr"), dir.join("obj.exr"));
-    let size = ["--size", "256x256"];
+    let size = ["--size", "256x256", "--voxels", TEST_VOXELS];
     render(
         &shared.join("scenes/gltf/cornell_point.gltf"),
         &[&size[..], &["--diffuse-only"]].concat(),

@@ -5,7 +5,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{render_256 as render, shared, stderr, temp_dir, voxcone};
+use common::{render_256 as render, shared, stderr, temp_dir, voxcone, TEST_OCTREE_DEPTH};
 use voxcone::compare::{compare, CompareOptions};
 use voxcone::imageio::load_rgb;
 
@@ -111,8 +111,9 @@ fn octree_renders_are_deterministic() {
     let scene = shared.join("reference/cornell_point.scene.json");
     let dir = temp_dir("octree_determinism");
     let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
-    render(&scene, &["--gi", "octree"], &a);
-    render(&scene, &["--gi", "octree"], &b);
+    let octree = ["--gi", "octree", "--octree-depth", TEST_OCTREE_DEPTH];
+    render(&scene, &octree, &a);
+    render(&scene, &octree, &b);
     let (a, b) = (load_rgb(&a).unwrap().0.data, load_rgb(&b).unwrap().0.data);
     let worst = a
         .iter()

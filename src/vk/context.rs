@@ -98,6 +98,27 @@ const NO_DEVICE_HELP: &str = "install a Vulkan driver: on Debian/Ubuntu `apt-get
      mesa-vulkan-drivers libvulkan1` gives the CPU driver lavapipe; `vulkaninfo --summary` \
      (package vulkan-tools) lists what the loader finds";
 
+/// The host's physical memory, bytes, where the system says.
+#[cfg(unix)]
+fn host_physical_bytes() -> Option<u64> {
+    // SAFETY: sysconf reads system constants; it has no preconditions.
+    let (pages, page) = unsafe {
+        (
+            libc::sysconf(libc::_SC_PHYS_PAGES),
+            libc::sysconf(libc::_SC_PAGESIZE),
+        )
+    };
+    let pages = u64::try_from(pages).ok()?;
+    let page = u64::try_from(page).ok()?;
+    pages.checked_mul(page)
+}
+
+/// The host's physical memory, bytes, where the system says.
+#[cfg(not(unix))]
+fn host_physical_bytes() -> Option<u64> {
+    None
+}
+
 impl Context {
     /// Whether the device is a CPU driver (lavapipe): there each workgroup costs more
     /// than a GPU's idle lanes, and some passes pick other strategies.
@@ -105,19 +126,28 @@ impl Context {
         self.properties.device_type == vk::PhysicalDeviceType::CPU
     }
 
-    /// The largest device-local memory heap, bytes.
+    /// The largest device-local memory heap, bytes. A CPU driver's device memory is the
+    /// host's, allocated as it is asked for (lavapipe's vkAllocateMemory is a malloc that
+    /// checks no heap), so there it is the host's physical memory where that is larger
+    /// than the heap the driver reports: Mesa 22.3's lavapipe reports a fixed 2 GiB, later
+    /// ones the host's physical memory.
     pub fn device_local_bytes(&self) -> u64 {
         // SAFETY: `physical_device` was enumerated from `instance`, which outlives `self`.
         let memory = unsafe {
             self.instance
                 .get_physical_device_memory_properties(self.physical_device)
         };
-        memory.memory_heaps[..memory.memory_heap_count as usize]
+        let heap = memory.memory_heaps[..memory.memory_heap_count as usize]
             .iter()
             .filter(|heap| heap.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
             .map(|heap| heap.size)
             .max()
-            .unwrap_or(0)
+            .unwrap_or(0);
+        if self.is_cpu() {
+            heap.max(host_physical_bytes().unwrap_or(0))
+        } else {
+            heap
+        }
     }
 
     pub fn new(options: &ContextOptions) -> Result<Arc<Self>> {
@@ -457,5 +487,27 @@ impl Drop for Context {
             }
             self.instance.destroy_instance(None);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The host's memory as the rule reads it (sysconf) is what the kernel reports in
+    /// /proc/meminfo (MemTotal, in KiB): both count the pages the kernel manages.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn host_memory_matches_the_kernels_count() {
+        let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap();
+        let kib: u64 = meminfo
+            .lines()
+            .find_map(|line| line.strip_prefix("MemTotal:"))
+            .and_then(|rest| rest.trim().strip_suffix("kB"))
+            .and_then(|n| n.trim().parse().ok())
+            .unwrap();
+        let bytes = super::host_physical_bytes().unwrap();
+        assert!(
+            bytes.abs_diff(kib * 1024) < 1 << 20,
+            "{bytes} against {kib} KiB"
+        );
     }
 }

@@ -16,6 +16,14 @@ pub fn shared() -> PathBuf {
     PathBuf::from(dir.unwrap_or_else(|| panic!("built without ../shared (see build.rs)")))
 }
 
+/// The cone tracer's resolution for the tests that do not test its rule: `render`'s
+/// default follows the host's memory (256³ where the host has 7 GiB, 128³ where it has
+/// less), and a test's figures must not; a render at 256³ also takes four to five times
+/// as long on lavapipe. 128³ is the default such tests were measured at.
+pub const TEST_VOXELS: &str = "128";
+/// The octree's depth of the same effective resolution, `TEST_VOXELS`.
+pub const TEST_OCTREE_DEPTH: &str = "7";
+
 /// A fresh directory for a test's files.
 pub fn temp_dir(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
