@@ -5,7 +5,9 @@ mod common;
 
 use std::path::Path;
 
-use common::{flat_plane, probe_furnace, render_256, shared, temp_dir, write, TEST_VOXELS};
+use common::{
+    flat_plane, probe_furnace, render_256, shared, temp_dir, write, TEST_OCTREE_DEPTH, TEST_VOXELS,
+};
 use voxcone::compare::{compare, CompareOptions};
 use voxcone::imageio::load_rgb;
 
@@ -258,11 +260,18 @@ fn shadow_cones_match_direct_reference() {
 fn bunny_with_shadow_cones_is_finite_everywhere() {
     let scene = shared().join("scenes/stanford_bunny/stanford-bunny.obj");
     let dir = temp_dir("bunny_shadow_cones");
-    for gi in ["dense", "svo"] {
+    for (gi, resolution) in [
+        ("dense", ["--voxels", TEST_VOXELS]),
+        ("svo", ["--octree-depth", TEST_OCTREE_DEPTH]),
+    ] {
         let out = dir.join(format!("{gi}.exr"));
         common::render(
             &scene,
-            &["--gi", gi, "--shadow-cones", "--size", "128x128"],
+            &[
+                &["--gi", gi, "--shadow-cones", "--size", "128x128"][..],
+                &resolution,
+            ]
+            .concat(),
             &out,
         );
         let (image, _) = load_rgb(&out).unwrap();

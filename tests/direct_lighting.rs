@@ -187,6 +187,8 @@ fn sponza_renders_with_textures() {
         scene.to_str().unwrap(),
         "--size",
         "512x512",
+        "--voxels",
+        common::TEST_VOXELS,
         "-o",
         out.to_str().unwrap(),
     ]);

@@ -168,6 +168,8 @@ fn octree_node_view_draws_nodes() {
         &[
             "--gi",
             "octree",
+            "--octree-depth",
+            TEST_OCTREE_DEPTH,
             "--debug-view",
             "octree-nodes",
             "--debug-level",
