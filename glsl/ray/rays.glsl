@@ -12,6 +12,11 @@
 #include "common/random.glsl"
 #include "ray/surfaces.glsl"
 
+// The scene's features (`RayFeatures`): without cut-outs the traversal has no coverage to
+// look up, without moving meshes no second BVH to walk.
+layout(constant_id = SPEC_RAY_CUT_OUTS) const bool RAY_CUT_OUTS = true;
+layout(constant_id = SPEC_RAY_MOVING) const bool RAY_MOVING_MESHES = true;
+
 layout(set = SET_GI, binding = BINDING_RAY_UNIFORMS) uniform RayBlock {
     RayUniforms rays;
 };
@@ -43,7 +48,7 @@ struct Hit {
 // 0), below a number drawn for this ray and triangle (another seed), or never
 // (`RAY_OPAQUE`).
 bool cut_out(uint i, RayTriangle tri, vec2 bary, uint cut_seed) {
-    if ((floatBitsToUint(tri.e2.w) & RAY_CUT_OUT) == 0u || cut_seed == RAY_OPAQUE) {
+    if (!RAY_CUT_OUTS || (floatBitsToUint(tri.e2.w) & RAY_CUT_OUT) == 0u || cut_seed == RAY_OPAQUE) {
         return false;
     }
     GpuMaterial m = ray_material(floatBitsToUint(tri.v0.w));
@@ -151,49 +156,74 @@ bool traverse(uint root, vec3 origin, vec3 dir, float tmin, bool any, uint cut_s
     // The root as the only inner child of a group at `root`.
     uvec2 nodes = uvec2(root, 0x80000000u);
     uvec2 triangles = uvec2(0u);
+    // A cut-out triangle the ray meets leaves the walk, to have its coverage looked up
+    // outside it and the walk resumed where it left off: a CPU driver runs the lookup's
+    // code at every step of the loop it sits in, whether any lane needs it or not (in the
+    // walk's loop it took half of Sponza's path-tracing time).
     while (true) {
-        while (triangles.y != 0u) {
-            uint k = uint(findMSB(triangles.y));
-            triangles.y &= ~(1u << k);
-            uint i = triangles.x + k;
-            float t;
-            vec2 bary;
-            RayTriangle tri = ray_triangle(i);
-            if (intersect_triangle(tri, origin, dir, tmin, hit.t, t, bary) && !cut_out(i, tri, bary, cut_seed)) {
-                hit.triangle = i;
-                hit.t = t;
-                hit.bary = bary;
-                found = true;
-                if (any) {
-                    return true;
+        bool pending = false;
+        Hit candidate;
+        while (true) {
+            while (triangles.y != 0u) {
+                uint k = uint(findMSB(triangles.y));
+                triangles.y &= ~(1u << k);
+                uint i = triangles.x + k;
+                float t;
+                vec2 bary;
+                RayTriangle tri = ray_triangle(i);
+                if (intersect_triangle(tri, origin, dir, tmin, hit.t, t, bary)) {
+                    if (RAY_CUT_OUTS && (floatBitsToUint(tri.e2.w) & RAY_CUT_OUT) != 0u) {
+                        candidate = Hit(i, t, bary);
+                        pending = true;
+                        break;
+                    }
+                    hit = Hit(i, t, bary);
+                    found = true;
+                    if (any) {
+                        return true;
+                    }
                 }
             }
-        }
-        if ((nodes.y & 0xff000000u) != 0u) {
-            uint group = nodes.y;
-            uint bit = uint(findMSB(group));
-            nodes.y &= ~(1u << bit);
-            if ((nodes.y & 0xff000000u) != 0u) {
-                // The BVHs are shallower than the stack (checked when built).
-                stack[top] = nodes;
-                top++;
-            }
-            // The child's slot, and its place among the node's inner children.
-            uint slot = (bit - 24u) ^ (oct_inv4 & 0xffu);
-            uint child = nodes.x + bitCount(group & ~(0xffffffffu << slot));
-            BvhNode n = bvh_node(child);
-            uint hits = intersect_children(n, origin, inv_dir, tmin, hit.t, oct_inv4);
-            nodes = uvec2(n.children.x, (hits & 0xff000000u) | (n.origin_scale.w >> 24u));
-            triangles = uvec2(n.children.y, hits & 0x00ffffffu);
-        } else {
-            nodes = uvec2(0u);
-        }
-        if (triangles.y == 0u && (nodes.y & 0xff000000u) == 0u) {
-            if (top == 0) {
+            if (RAY_CUT_OUTS && pending) {
                 break;
             }
-            top--;
-            nodes = stack[top];
+            if ((nodes.y & 0xff000000u) != 0u) {
+                uint group = nodes.y;
+                uint bit = uint(findMSB(group));
+                nodes.y &= ~(1u << bit);
+                if ((nodes.y & 0xff000000u) != 0u) {
+                    // The BVHs are shallower than the stack (checked when built).
+                    stack[top] = nodes;
+                    top++;
+                }
+                // The child's slot, and its place among the node's inner children.
+                uint slot = (bit - 24u) ^ (oct_inv4 & 0xffu);
+                uint child = nodes.x + bitCount(group & ~(0xffffffffu << slot));
+                BvhNode n = bvh_node(child);
+                uint hits = intersect_children(n, origin, inv_dir, tmin, hit.t, oct_inv4);
+                nodes = uvec2(n.children.x, (hits & 0xff000000u) | (n.origin_scale.w >> 24u));
+                triangles = uvec2(n.children.y, hits & 0x00ffffffu);
+            } else {
+                nodes = uvec2(0u);
+            }
+            if (triangles.y == 0u && (nodes.y & 0xff000000u) == 0u) {
+                if (top == 0) {
+                    break;
+                }
+                top--;
+                nodes = stack[top];
+            }
+        }
+        if (!RAY_CUT_OUTS || !pending) {
+            break;
+        }
+        // Met before any hit since: still the nearest.
+        if (!cut_out(candidate.triangle, ray_triangle(candidate.triangle), candidate.bary, cut_seed)) {
+            hit = candidate;
+            found = true;
+            if (any) {
+                return true;
+            }
         }
     }
     return found;
@@ -205,7 +235,9 @@ bool trace_closest(vec3 origin, vec3 dir, float tmin, float tmax, uint cut_seed,
     hit.t = tmax;
     hit.bary = vec2(0.0);
     bool found = traverse(rays.static_root, origin, dir, tmin, false, cut_seed, hit);
-    found = traverse(rays.moving_root, origin, dir, tmin, false, cut_seed, hit) || found;
+    if (RAY_MOVING_MESHES) {
+        found = traverse(rays.moving_root, origin, dir, tmin, false, cut_seed, hit) || found;
+    }
     return found;
 }
 
@@ -217,6 +249,6 @@ bool trace_any(vec3 origin, vec3 dir, float tmin, float tmax, uint cut_seed) {
     hit.t = tmax;
     hit.bary = vec2(0.0);
     return traverse(rays.static_root, origin, dir, tmin, true, cut_seed, hit) ||
-           traverse(rays.moving_root, origin, dir, tmin, true, cut_seed, hit);
+           (RAY_MOVING_MESHES && traverse(rays.moving_root, origin, dir, tmin, true, cut_seed, hit));
 }
 #endif

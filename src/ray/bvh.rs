@@ -33,9 +33,7 @@ impl Triangles {
                 continue;
             }
             let material = &scene.materials[mesh.material as usize];
-            let cut_out = material.coverage_texture.is_some()
-                || (material.dissolve < 1.0 && !material.refracts());
-            let flags = u32::from(cut_out) * layout::RAY_CUT_OUT
+            let flags = u32::from(material.cut_out()) * layout::RAY_CUT_OUT
                 + u32::from(mesh.animation.is_some()) * layout::RAY_MOVING;
             let transform = scene.mesh_transform(m, time_s);
             let normals = Mat3::from_mat4(transform).inverse().transpose();

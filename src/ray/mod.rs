@@ -48,6 +48,58 @@ pub struct BuildStats {
 }
 
 /// The scene's triangles on the GPU, ready to cast rays against.
+/// What the scene asks of the passes that cast rays, each a specialization constant
+/// (`SPEC_RAY_*`, and `SPEC_PATH_*` for the path tracer), so that the code of what the
+/// scene lacks is not compiled in: a CPU driver runs every branch an invocation group
+/// meets, taken or not.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayFeatures {
+    /// Some triangle is cut out (`RAY_CUT_OUT`).
+    pub cut_outs: bool,
+    /// The scene has moving meshes.
+    pub moving: bool,
+    /// Some material has an albedo or emission texture.
+    pub textures: bool,
+    /// Some material has a normal map.
+    pub normal_maps: bool,
+    /// Some material has a specular lobe (Ks > 0).
+    pub specular: bool,
+    /// Some material refracts (d < 1, Ni > 1).
+    pub transmission: bool,
+    /// Next-event estimation has emissive triangles to sample.
+    pub emitters: bool,
+}
+
+impl RayFeatures {
+    /// The features of the materials the scene's meshes use (those of the GPU materials
+    /// the shaders read, `gpu_materials`); `emitters` is left to the emitters' list.
+    fn of(scene: &Scene) -> Self {
+        let mut f = Self {
+            moving: scene.meshes.iter().any(|m| m.animation.is_some()),
+            ..Self::default()
+        };
+        for mesh in &scene.meshes {
+            let m = &scene.materials[mesh.material as usize];
+            f.cut_outs |= m.cut_out();
+            f.textures |= m.albedo_texture.is_some() || m.emission_texture.is_some();
+            f.normal_maps |= m.normal_texture.is_some();
+            f.specular |= m.specular.max_element() > 0.0;
+            f.transmission |= m.refracts();
+        }
+        f
+    }
+
+    /// The constants of the ray casting's include (`glsl/ray/rays.glsl`), ids
+    /// `SPEC_RAY_CUT_OUTS` and `SPEC_RAY_MOVING`, which every pass that casts rays takes
+    /// first.
+    pub fn ray_constants(&self) -> [u32; 2] {
+        let mut c = [0; 2];
+        c[layout::SPEC_RAY_CUT_OUTS as usize] = u32::from(self.cut_outs);
+        c[layout::SPEC_RAY_MOVING as usize] = u32::from(self.moving);
+        c
+    }
+}
+
 pub struct SceneRays {
     uniforms: Buffer,
     nodes: TexelBuffer,
@@ -64,6 +116,7 @@ pub struct SceneRays {
     /// copy in.
     staging: Vec<Buffer>,
     pub stats: BuildStats,
+    pub features: RayFeatures,
     ctx: Arc<Context>,
 }
 
@@ -220,6 +273,10 @@ impl SceneRays {
             moving_triangles,
             staging,
             stats,
+            features: RayFeatures {
+                emitters: emitter_count > 0,
+                ..RayFeatures::of(scene)
+            },
             ctx: ctx.clone(),
         })
     }

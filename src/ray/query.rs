@@ -38,12 +38,13 @@ impl RayQueries {
         let sets = DescriptorSets::new(ctx, "ray queries", &bindings, 1)?;
         let set = sets.allocate("ray queries")?;
         let empty = DescriptorSets::new(ctx, "empty", &[], 1)?;
-        let pipeline = Pipeline::compute(
+        let pipeline = Pipeline::compute_specialized(
             ctx,
             "ray_query",
             crate::vk::shaders::RAY_QUERY_COMP,
             &[empty.layout, empty.layout, empty.layout, sets.layout],
             4,
+            &rays.features.ray_constants(),
         )?;
         let bytes = |element: usize| (element * capacity) as u64;
         let queries = Buffer::new(

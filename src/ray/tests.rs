@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::host::bounce_rate;
 use super::query::RayQueries;
 use super::surfaces::check_buffer_size;
-use super::{SceneRays, Triangles};
+use super::{RayFeatures, SceneRays, Triangles};
 use crate::gi::bounces::converged_bounces;
 use crate::gpu_layout::{RayHit, RayQuery, RAY_ANY, RAY_CLOSEST, RAY_NONE};
 use crate::scene::testing::{shared_file, TempDir};
@@ -378,6 +378,62 @@ fn cut_outs_pass_rays_where_coverage_is_below_one_half() {
         }
     }
     assert_eq!(ctx.validation_messages(), 0);
+}
+
+/// The path tracer's and the ray caster's specialization follows the materials the meshes
+/// use, under the switches that change them: none for a plain material beside others the
+/// MTL defines and no mesh uses; each feature for the material that has it.
+#[test]
+fn features_follow_the_materials_the_meshes_use() {
+    let dir = TempDir::new("ray_features");
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([128, 128, 255, 255]))
+        .save(dir.0.join("t.png"))
+        .unwrap();
+    dir.write(
+        "m.mtl",
+        "newmtl plain\nKd 0.5 0.5 0.5\nnewmtl glossy\nKd 0.5 0.5 0.5\nKs 0.3 0.3 0.3\nNs 50\n\
+         newmtl leaf\nKd 0.5 0.5 0.5\nmap_d t.png\nnewmtl veil\nKd 1 1 1\nd 0.3\n\
+         newmtl glass\nKd 1 1 1\nd 0.3\nNi 1.5\nnewmtl painted\nKd 1 1 1\nmap_Kd t.png\n\
+         newmtl bumpy\nKd 1 1 1\nnorm t.png\n",
+    );
+    let features = |materials: &[&str], options: &LoadOptions| {
+        let mut obj = String::from("mtllib m.mtl\nvt 0 0\nvt 1 0\nvt 1 1\n");
+        for (k, m) in materials.iter().enumerate() {
+            let z = k as f32;
+            obj += &format!("v 0 0 {z}\nv 1 0 {z}\nv 1 1 {z}\nusemtl {m}\n");
+            obj += &format!("f {0}/1 {1}/2 {2}/3\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+        }
+        let path = dir.write("m.obj", &obj);
+        RayFeatures::of(&Scene::load(&path, options).unwrap())
+    };
+    let plain = LoadOptions::default();
+    let none = RayFeatures::default();
+    assert_eq!(features(&["plain"], &plain), none);
+    let with = |f: fn(&mut RayFeatures)| {
+        let mut r = none;
+        f(&mut r);
+        r
+    };
+    let cases: [(&str, RayFeatures); 6] = [
+        ("glossy", with(|f| f.specular = true)),
+        ("leaf", with(|f| f.cut_outs = true)),
+        ("veil", with(|f| f.cut_outs = true)),
+        ("glass", with(|f| f.transmission = true)),
+        ("painted", with(|f| f.textures = true)),
+        ("bumpy", with(|f| f.normal_maps = true)),
+    ];
+    for (material, expected) in cases {
+        assert_eq!(
+            features(&["plain", material], &plain),
+            expected,
+            "{material}"
+        );
+    }
+    // The references' switches: Lambertian, no normal maps, the glass a straight mask.
+    assert_eq!(
+        features(&["glossy", "bumpy", "glass"], &LoadOptions::REFERENCE),
+        with(|f| f.cut_outs = true)
+    );
 }
 
 /// A scene whose buffers the device cannot bind is refused with the sizes named (a scene

@@ -170,6 +170,12 @@ impl Material {
     pub fn refracts(&self) -> bool {
         self.dissolve < 1.0 && self.ior > 1.0
     }
+
+    /// Whether rays pass the surface where its coverage (d x map_d, map_d alone where it
+    /// refracts) falls short: ray casting's `RAY_CUT_OUT`.
+    pub fn cut_out(&self) -> bool {
+        self.coverage_texture.is_some() || (self.dissolve < 1.0 && !self.refracts())
+    }
 }
 
 /// How to load a scene.

@@ -28,6 +28,14 @@ layout(set = SET_SCREEN, binding = BINDING_SCREEN_RADIANCE, rgba32f) uniform wri
 layout(push_constant) uniform Push {
     PathPush push;
 };
+// The scene's materials' features and the cone component (`PathTracer::constants`): the
+// code of what the scene lacks is left out, as `RAY_CUT_OUTS` leaves the coverage out.
+layout(constant_id = SPEC_PATH_TEXTURES) const bool PATH_TEXTURES = true;
+layout(constant_id = SPEC_PATH_NORMAL_MAPS) const bool PATH_NORMAL_MAPS = true;
+layout(constant_id = SPEC_PATH_SPECULAR) const bool PATH_SPECULAR = true;
+layout(constant_id = SPEC_PATH_TRANSMISSION) const bool PATH_TRANSMISSION = true;
+layout(constant_id = SPEC_PATH_EMITTERS) const bool PATH_EMITTERS = true;
+layout(constant_id = SPEC_PATH_CONE) const bool PATH_CONE = true;
 
 // Rays this invocation cast.
 uint rays_here = 0u;
@@ -94,20 +102,20 @@ Surface surface_at(Hit hit, vec3 dir) {
     ns = dot(ns, ns) > 1e-12 ? normalize(ns) : s.ng;
     s.ns = dot(ns, s.ng) < 0.0 ? -ns : ns;
     vec2 uv = triangle_uv(hit.triangle, hit.bary);
-    if (m.normal_texture != NO_TEXTURE) {
+    if (PATH_NORMAL_MAPS && m.normal_texture != NO_TEXTURE) {
         s.ns = apply_normal_map(hit.triangle, s.ns, m.normal_texture, uv);
     }
     s.v = -dir;
     s.albedo = m.albedo.rgb;
-    if (m.albedo_texture != NO_TEXTURE) {
+    if (PATH_TEXTURES && m.albedo_texture != NO_TEXTURE) {
         s.albedo *= texture_bilinear(m.albedo_texture, uv, true).rgb;
     }
     s.specular = dot(m.specular.rgb, vec3(1.0 / 3.0));
     s.roughness = m.specular.a;
-    s.transmit = material_refracts(m) ? 1.0 - m.albedo.a : 0.0;
+    s.transmit = PATH_TRANSMISSION && material_refracts(m) ? 1.0 - m.albedo.a : 0.0;
     s.eta = front ? m.emission.a : 1.0 / m.emission.a;
     s.emitted = front ? m.emission.rgb : vec3(0.0);
-    if (front && m.emission_texture != NO_TEXTURE) {
+    if (PATH_TEXTURES && front && m.emission_texture != NO_TEXTURE) {
         s.emitted *= texture_bilinear(m.emission_texture, uv, true).rgb;
     }
     return s;
@@ -151,7 +159,7 @@ float phong_exponent(float roughness) {
 // lobe's share of the two weights.
 float lobe_choice(Surface s) {
     float diffuse = dot(s.albedo, vec3(1.0 / 3.0));
-    return s.specular > 0.0 ? s.specular / (s.specular + diffuse) : 0.0;
+    return PATH_SPECULAR && s.specular > 0.0 ? s.specular / (s.specular + diffuse) : 0.0;
 }
 
 // The density of direction `l` under the sampling of `sample_bsdf` at `s`: cos / pi
@@ -177,7 +185,7 @@ float bsdf_pdf(Surface s, vec3 l) {
 // A direction from `s` for the next vertex, by `lobe_choice`: the cosine or a half-vector
 // about the shading normal from the Blinn-Phong lobe, the view mirrored about it.
 vec3 sample_bsdf(Surface s, inout uint rng) {
-    if (random_next(rng) >= lobe_choice(s)) {
+    if (random_next(rng) >= lobe_choice(s) || !PATH_SPECULAR) {
         return sample_cosine(s.ns, rng);
     }
     float e = phong_exponent(s.roughness);
@@ -192,7 +200,7 @@ vec3 sample_bsdf(Surface s, inout uint rng) {
 
 // The BRDF at `s` for light arriving from `l`: the lighting pass's `surface_brdf`.
 vec3 brdf(Surface s, vec3 l) {
-    return surface_brdf(s.albedo, s.specular, s.roughness, s.ns, s.v, l);
+    return PATH_SPECULAR ? surface_brdf(s.albedo, s.specular, s.roughness, s.ns, s.v, l) : s.albedo / PI;
 }
 
 // The density, in solid angle at a point `dist` away, with which next-event estimation
@@ -239,7 +247,7 @@ vec3 delta_lights(Surface s, vec3 origin, inout uint rng) {
 
 // Radiance from one emitter point picked by power, weighted against cosine sampling.
 vec3 emitter_light(Surface s, vec3 origin, inout uint rng) {
-    if (rays.emitter_count == 0u) {
+    if (!PATH_EMITTERS || rays.emitter_count == 0u) {
         return vec3(0.0);
     }
     float pick = random_next(rng);
@@ -272,7 +280,7 @@ vec3 emitter_light(Surface s, vec3 origin, inout uint rng) {
     GpuMaterial em = ray_material(floatBitsToUint(tri.v0.w));
     vec3 radiance = em.emission.rgb;
     float light_pdf = emitter_pdf(max(radiance.r, max(radiance.g, radiance.b)), dist, cos_light);
-    if (em.emission_texture != NO_TEXTURE) {
+    if (PATH_TEXTURES && em.emission_texture != NO_TEXTURE) {
         radiance *= texture_bilinear(em.emission_texture, triangle_uv(emitter, vec2(su * (1.0 - r), su * r)), true).rgb;
     }
     float weight = mis_weight(light_pdf, bsdf_pdf(s, l));
@@ -316,7 +324,7 @@ Path start_path(uvec2 pixel, uint index) {
 // The cone component (`--cone`): the camera's hit gathers albedo times the radiance
 // from one cone of the cone tracer's gather, instead of its own light.
 bool cone_component(Path p) {
-    return p.depth == 1u && path.cone != 0xffffffffu;
+    return PATH_CONE && p.depth == 1u && path.cone != 0xffffffffu;
 }
 
 // Russian roulette from `rr_depth` on: whether the path goes on, its throughput raised
@@ -345,7 +353,7 @@ bool extend(inout Path p) {
     if (any(greaterThan(s.emitted, vec3(0.0))) && !cone_component(p)) {
         float weight = 1.0;
         RayTriangle tri = ray_triangle(hit.triangle);
-        bool sampled = (floatBitsToUint(tri.e2.w) & RAY_MOVING) == 0u && rays.emitter_count > 0u;
+        bool sampled = PATH_EMITTERS && (floatBitsToUint(tri.e2.w) & RAY_MOVING) == 0u && rays.emitter_count > 0u;
         if (p.bsdf_pdf > 0.0 && sampled) {
             vec3 factor = ray_material(floatBitsToUint(tri.v0.w)).emission.rgb;
             float largest = max(factor.r, max(factor.g, factor.b));
@@ -380,7 +388,7 @@ bool extend(inout Path p) {
         p.depth++;
         return true;
     }
-    if (s.transmit > 0.0 && random_next(p.rng) < s.transmit) {
+    if (PATH_TRANSMISSION && s.transmit > 0.0 && random_next(p.rng) < s.transmit) {
         // The light passing the surface, refracted (reflected where it cannot leave):
         // a direction no other technique samples, so an emitter it reaches counts whole.
         vec3 bent = refract(p.dir, s.ng, 1.0 / s.eta);

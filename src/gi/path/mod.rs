@@ -21,7 +21,7 @@ use super::{
     ScreenRequest, Switch, Technique,
 };
 use crate::gpu_layout::{self as layout, PathPush, PathUniforms};
-use crate::ray::SceneRays;
+use crate::ray::{RayFeatures, SceneRays};
 use crate::vk::{
     groups_2d, memory_barrier, to_compute_write, Binding, Buffer, Context, DescriptorSets, Image,
     ImageDesc, Pipeline, SetWriter,
@@ -161,12 +161,17 @@ impl PathTracer {
         let sets = DescriptorSets::new(ctx, "path", &bindings, 1)?;
         let set = sets.allocate("path")?;
         let [frame, scene, screen] = inputs.set_layouts;
-        let pipeline = Pipeline::compute(
+        log::info!(
+            "path tracer compiled for the scene's features: {:?}",
+            rays.features
+        );
+        let pipeline = Pipeline::compute_specialized(
             ctx,
             "path_trace",
             crate::vk::shaders::GI_PATH_TRACE_COMP,
             &[frame, scene, screen, sets.layout],
             std::mem::size_of::<PathPush>() as u32,
+            &Self::constants(&rays.features, settings),
         )?;
         let uniforms = PathUniforms {
             max_depth: settings.max_depth.unwrap_or(0),
@@ -228,6 +233,20 @@ impl PathTracer {
             extent: vk::Extent2D::default(),
             ctx: ctx.clone(),
         })
+    }
+
+    /// The pipeline's specialization constants: the ray casting's, then the scene's
+    /// materials' features and the cone component (`SPEC_PATH_*`).
+    fn constants(f: &RayFeatures, settings: &PathSettings) -> [u32; 8] {
+        let mut c = [0; 8];
+        c[..2].copy_from_slice(&f.ray_constants());
+        c[layout::SPEC_PATH_TEXTURES as usize] = u32::from(f.textures);
+        c[layout::SPEC_PATH_NORMAL_MAPS as usize] = u32::from(f.normal_maps);
+        c[layout::SPEC_PATH_SPECULAR as usize] = u32::from(f.specular);
+        c[layout::SPEC_PATH_TRANSMISSION as usize] = u32::from(f.transmission);
+        c[layout::SPEC_PATH_EMITTERS as usize] = u32::from(f.emitters);
+        c[layout::SPEC_PATH_CONE as usize] = u32::from(settings.cone.is_some());
+        c
     }
 
     /// What the image depends on besides the scene's static meshes: the camera and image
