@@ -474,6 +474,9 @@ gpu_layout! {
         BINDING_PROBE_WORK = 31;
         /// Irradiance probes (set 3): `ProbeView` uniform buffer.
         BINDING_PROBE_VIEW = 32;
+        /// Irradiance probes (set 3): the same λ as `BINDING_PROBE_LAMBDA`, as a `samplerBuffer`
+        /// of an RGB texel each, for the basis pass.
+        BINDING_PROBE_LAMBDA_TEXELS = 33;
         /// Workgroup size of the probe passes.
         PROBE_GROUP_SIZE = 64;
 

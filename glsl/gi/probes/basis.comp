@@ -11,9 +11,7 @@ layout(constant_id = 0) const uint COEFFICIENTS = 16u;
 layout(set = SET_GI, binding = BINDING_PROBE_VECTORS) uniform usamplerBuffer vectors;
 layout(set = SET_GI, binding = BINDING_PROBE_CLUSTER_PROBES) uniform usamplerBuffer cluster_probes;
 layout(set = SET_GI, binding = BINDING_PROBE_PROJECTIONS) uniform samplerBuffer projections;
-layout(set = SET_GI, binding = BINDING_PROBE_LAMBDA, std430) readonly buffer LambdaBlock {
-    vec4 lambda[];
-};
+layout(set = SET_GI, binding = BINDING_PROBE_LAMBDA_TEXELS) uniform samplerBuffer lambda;
 layout(set = SET_GI, binding = BINDING_PROBE_BASIS, std430) writeonly buffer BasisBlock {
     vec4 basis[];
 };
@@ -44,7 +42,7 @@ void main() {
         uint first = probe * COEFFICIENTS;
         int at = int(vector.z + k * COEFFICIENTS);
         for (uint j = 0u; j < count; j++) {
-            b += texelFetch(projections, at + int(j)).r * lambda[first + j].rgb;
+            b += texelFetch(projections, at + int(j)).r * texelFetch(lambda, int(first + j)).rgb;
         }
     }
     basis[v] = vec4(b, 0.0);

@@ -642,7 +642,7 @@ pub struct ProbeGi {
     hits: TexelBuffer,
     hit_surfaces: TexelBuffer,
     uniforms: Buffer,
-    lambda: Buffer,
+    lambda: TexelBuffer,
     basis: Buffer,
     /// Per lightmap, a view of each of its levels (dropped before the lightmaps).
     _level_views: Vec<OwnedView>,
@@ -777,12 +777,27 @@ impl ProbeGi {
         )?;
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let vec4 = 16u64;
-        let lambda = Buffer::new(
-            ctx,
+        let lambdas = u64::from(counts.probe_count) * u64::from(counts.coefficients);
+        if lambdas > texel_limit {
+            bail!(
+                "the probes' {lambdas} harmonic coefficients are more texels than the \
+                 {texel_limit} this device binds in one texel buffer: bake fewer --probes or \
+                 a lower --sh-order"
+            );
+        }
+        // Written by the relight as storage, read by the basis pass as texels: a CPU
+        // driver fetches texels for all SIMD lanes at once, where it loads a storage
+        // buffer one lane and one word at a time (`surfaces.glsl`).
+        let lambda = TexelBuffer::new(
             "probe lambda",
-            (vec4 * u64::from(counts.probe_count * counts.coefficients)).max(vec4),
-            storage,
-            MemoryLocation::GpuOnly,
+            Buffer::new(
+                ctx,
+                "probe lambda",
+                (vec4 * lambdas).max(vec4),
+                storage | vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
+                MemoryLocation::GpuOnly,
+            )?,
+            vk::Format::R32G32B32A32_SFLOAT,
         )?;
         let basis = Buffer::new(
             ctx,
@@ -967,6 +982,7 @@ impl ProbeGi {
                 vk::DescriptorType::STORAGE_BUFFER,
                 compute,
             ),
+            Binding::new(layout::BINDING_PROBE_LAMBDA_TEXELS, texels, compute),
             Binding::new(layout::BINDING_PROBE_VECTORS, texels, compute),
             Binding::new(layout::BINDING_PROBE_CLUSTER_PROBES, texels, compute),
             Binding::new(layout::BINDING_PROBE_PROJECTIONS, texels, compute),
@@ -1041,7 +1057,12 @@ impl ProbeGi {
                     vk::DescriptorType::UNIFORM_BUFFER,
                     uniforms.raw,
                 )
-                .buffer(layout::BINDING_PROBE_LAMBDA, storage_buffer, lambda.raw)
+                .buffer(
+                    layout::BINDING_PROBE_LAMBDA,
+                    storage_buffer,
+                    lambda.buffer.raw,
+                )
+                .texel_buffer(layout::BINDING_PROBE_LAMBDA_TEXELS, lambda.view())
                 .buffer(layout::BINDING_PROBE_BASIS, storage_buffer, basis.raw)
                 .buffer(
                     layout::BINDING_PROBE_GRID_ACTIVE,
@@ -1402,7 +1423,7 @@ impl Technique for ProbeGi {
         ));
         bytes.push((
             "probe_lambda_and_basis",
-            self.lambda.size + self.basis.size + self.uniforms.size,
+            self.lambda.buffer.size + self.basis.size + self.uniforms.size,
         ));
         bytes.push((
             "probe_lightmaps",
