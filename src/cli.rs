@@ -479,6 +479,7 @@ impl CommonArgs {
                 budget_mib: self.shadow_budget,
             },
             cache_shadows: true,
+            anisotropy_on_cpu: quality == Quality::Accurate,
             opaque_shadow_cut_outs: self.is_reference(),
             terms: Terms {
                 direct: !self.no_direct,
@@ -835,6 +836,23 @@ mod tests {
         );
         assert_eq!(gi.cones.diffuse_cones, 9);
         assert!(gi.cones.snapped_cones);
+    }
+
+    /// Textures are filtered anisotropically on a CPU driver for one image, not for frames
+    /// (`--quality` chooses, as for the cones), whatever the technique.
+    #[test]
+    fn a_cpu_driver_filters_anisotropically_for_one_image_only() {
+        let anisotropy = |args: &[&str]| {
+            settings_of(args, &GiOverrides::default())
+                .unwrap()
+                .anisotropy_on_cpu
+        };
+        assert!(anisotropy(&["voxcone", "render"]));
+        assert!(anisotropy(&["voxcone", "render", "--gi", "off"]));
+        assert!(!anisotropy(&["voxcone", "render", "--quality", "fast"]));
+        assert!(!anisotropy(&["voxcone", "view", "--gi", "probes"]));
+        assert!(!anisotropy(&["voxcone", "bench"]));
+        assert!(anisotropy(&["voxcone", "bench", "--quality", "accurate"]));
     }
 
     /// `render` takes the accurate defaults (the lattice, the voxels by memory), `view`

@@ -88,7 +88,7 @@ impl Renderer {
             gi: settings.gi.on(ctx, &scene),
             ..settings
         };
-        let gpu = GpuScene::new(ctx, &scene)?;
+        let gpu = GpuScene::new(ctx, &scene, settings.anisotropy_on_cpu || !ctx.is_cpu())?;
         let frame_sets = DescriptorSets::new(
             ctx,
             "frame",

@@ -205,7 +205,10 @@ impl GpuScene {
         ]
     }
 
-    pub fn new(ctx: &Arc<Context>, scene: &Scene) -> Result<Self> {
+    /// The scene's buffers, textures and material sets; the materials' sampler filters
+    /// anisotropically (8×) where `anisotropy` and the device offers it
+    /// (`RenderSettings::anisotropy_on_cpu`).
+    pub fn new(ctx: &Arc<Context>, scene: &Scene, anisotropy: bool) -> Result<Self> {
         let one_shot = OneShot::new(ctx)?;
         let mut vertices: Vec<Vertex> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
@@ -284,7 +287,7 @@ impl GpuScene {
             ctx,
             "material sampler",
             &sampler_info(vk::Filter::LINEAR, vk::SamplerAddressMode::REPEAT)
-                .anisotropy_enable(ctx.features.sampler_anisotropy)
+                .anisotropy_enable(anisotropy && ctx.features.sampler_anisotropy)
                 .max_anisotropy(max_anisotropy),
         )?;
         let sets = DescriptorSets::new(

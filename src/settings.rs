@@ -56,6 +56,12 @@ pub struct RenderSettings {
     pub shadow_resolution: ShadowResolution,
     /// Keep the shadow maps while no light and no mesh moves.
     pub cache_shadows: bool,
+    /// Filter the materials' textures anisotropically on a CPU driver too (one image:
+    /// grazing textures as sharp as the references' many samples per pixel make them).
+    /// Off, a CPU driver filters them trilinearly: its anisotropic filter took 480 of the
+    /// G-buffer's 760 ms on Sponza at 1280×720 (lavapipe). GPUs always filter them
+    /// anisotropically.
+    pub anisotropy_on_cpu: bool,
     /// Cut-outs (map_d) cast whole shadows from the lights, whatever their coverage: the
     /// references' convention (their Mitsuba integrator ignores its masks on the rays of
     /// next-event estimation, as the path tracer does under the same switch), implied by a
@@ -79,6 +85,7 @@ impl Default for RenderSettings {
             tonemap: Tonemap::Clamp,
             shadow_resolution: ShadowResolution::default(),
             cache_shadows: true,
+            anisotropy_on_cpu: true,
             opaque_shadow_cut_outs: false,
             gi: GiSettings::Off,
             terms: Terms::default(),

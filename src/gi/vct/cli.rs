@@ -18,7 +18,9 @@ pub struct VctArgs {
     /// (the lattice of 72 cones, whose error falls as the voxels get finer, at the most
     /// voxels the device's memory holds, up to 256 per axis; the ring where an option of
     /// the ring is given: --diffuse-cones, --cosine-cones, --snapped-cones, the steps'
-    /// factors, --cone); also the shadow maps' texels (--shadow-res, --sun-shadow-res)
+    /// factors, --cone); also the shadow maps' texels (--shadow-res, --sun-shadow-res),
+    /// and on a CPU driver whether textures are filtered anisotropically (accurate) or
+    /// trilinearly (fast: about half of a textured scene's frame there)
     /// [default: accurate for render, fast for view and bench].
     #[arg(long, value_enum)]
     pub quality: Option<Quality>,
