@@ -48,7 +48,7 @@ struct Hit {
 // 0), below a number drawn for this ray and triangle (another seed), or never
 // (`RAY_OPAQUE`).
 bool cut_out(uint i, RayTriangle tri, vec2 bary, uint cut_seed) {
-    if (!RAY_CUT_OUTS || (floatBitsToUint(tri.e2.w) & RAY_CUT_OUT) == 0u || cut_seed == RAY_OPAQUE) {
+    if ((floatBitsToUint(tri.e2.w) & RAY_CUT_OUT) == 0u || cut_seed == RAY_OPAQUE) {
         return false;
     }
     GpuMaterial m = ray_material(floatBitsToUint(tri.v0.w));

@@ -75,7 +75,7 @@ impl RayFeatures {
     /// the shaders read, `gpu_materials`); `emitters` is left to the emitters' list.
     fn of(scene: &Scene) -> Self {
         let mut f = Self {
-            moving: scene.meshes.iter().any(|m| m.animation.is_some()),
+            moving: scene.has_moving_meshes(),
             ..Self::default()
         };
         for mesh in &scene.meshes {
