@@ -958,7 +958,7 @@ gpu_layout! {
     struct ProbeUniforms {
         /// Probes.
         uint probe_count,
-        /// Rays (map texels) per probe.
+        /// Relight rays per probe (the texels of all its relight maps).
         uint rays_per_probe,
         /// Harmonic coefficients per colour channel, (order + 1)².
         uint coefficients,
@@ -972,6 +972,10 @@ gpu_layout! {
         uint bounces,
         /// The radius of the spheres the probes' debug view draws, in world units.
         float debug_radius,
+        /// Per level of detail, where the relight map it reads begins among a probe's rays.
+        uvec4 relight_first,
+        /// Per level of detail, the side of the relight map it reads.
+        uvec4 relight_side,
         /// The grid of spatial receivers: its points along x, y and z, and their count (0: no grid); the receivers of direction d and point p are receiver `receiver_count + d * grid_size.w + p`.
         uvec4 grid_size,
         /// The grid's box's least corner (xyz).

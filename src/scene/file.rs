@@ -73,6 +73,7 @@
 //! probes = 256                   # --probes
 //! overlaps = 10                  # --overlaps
 //! probe_side = 64                # --probe-side
+//! relight_side = 64              # --relight-side
 //! receiver_rays = 64             # --receiver-rays
 //! sh_order = 7                   # --sh-order
 //! pca_error = 0.005              # --pca-error

@@ -229,11 +229,13 @@ pub struct GiOverrides {
     /// The path tracer's longest path (a reference's `flags.max_depth`, where it has one).
     pub max_depth: Option<u32>,
     /// The irradiance probes' bake: lightmap page size, desired probe count, N_OVERLAPS,
-    /// each probe's map side, rays per receiver, highest harmonic band.
+    /// each probe's map side, its relight map's side, rays per receiver, highest harmonic
+    /// band.
     pub lightmap_size: Option<u32>,
     pub probes: Option<u32>,
     pub overlaps: Option<u32>,
     pub probe_side: Option<u32>,
+    pub relight_side: Option<u32>,
     pub receiver_rays: Option<u32>,
     pub sh_order: Option<u32>,
     /// The irradiance probes' clustered PCA: error bound and most basis vectors.

@@ -1,8 +1,9 @@
 #version 460
 // Probe relight and projection (Sedláček 2019, 3.3.1.1 and 3.3.1.2), a workgroup per
 // probe: the radiance each of its rays meets, projected onto the real harmonics,
-// λ_j = Σ_rays L Y_j dω (the octahedral map's texels are equal in solid angle, and
-// BINDING_PROBE_SH holds Y_j dω). The radiance at a hit is what a Lambertian surface
+// λ_j = Σ_rays L Y_j dω over the rays of one of its relight maps (`RelightRays`: an
+// equal-area octahedral map's texels, so dω is 4π over its texels; BINDING_PROBE_SH holds
+// Y_j dω). The radiance at a hit is what a Lambertian surface
 // sends back towards the probe, in the lighting pass's units and model:
 // - the direct light of every light, shadowed by the frame's shadow maps, × albedo / π;
 // - the emission, from the front of an emitter only (one-sided, as the G-buffer);
@@ -75,26 +76,22 @@ void main() {
     uint probe = gl_WorkGroupID.x;
     uint lane = gl_LocalInvocationID.x;
     // The level of detail (4.2.1): the first `count` coefficients (the low bands are the
-    // same functions whatever the order), from the texels at the centres of stride ×
-    // stride blocks of the map, each standing for its block's solid angle.
+    // same functions whatever the order), from the rays of the level's relight map
+    // (BINDING_PROBE_SH holds each ray's solid angle, its map's).
     uint count = min(lod[probe] & 0xFFFFu, COEFFICIENTS);
-    uint stride = lod[probe] >> 16u;
-    // The map is square: its side is exact in floats up to the largest maps.
-    uint side = uint(round(sqrt(float(probes.rays_per_probe))));
-    uint sub = side / stride;
-    float weight = float(probes.rays_per_probe) / float(sub * sub);
+    uint level = lod[probe] >> 16u;
+    uint side = probes.relight_side[level];
+    uint first = probes.relight_first[level];
     vec3 sums[COEFFICIENTS];
     for (uint j = 0u; j < COEFFICIENTS; j++) {
         sums[j] = vec3(0.0);
     }
-    uint first = probe * probes.rays_per_probe;
-    for (uint i = lane; i < sub * sub; i += PROBE_GROUP_SIZE) {
-        uint ray = ((i / sub) * stride + stride / 2u) * side + (i % sub) * stride + stride / 2u;
-        vec3 l = radiance_along(first + ray);
+    for (uint i = lane; i < side * side; i += PROBE_GROUP_SIZE) {
+        uint ray = first + i;
+        vec3 l = radiance_along(probe * probes.rays_per_probe + ray);
         if (all(equal(l, vec3(0.0)))) {
             continue;
         }
-        l *= weight;
         int at = int(ray * COEFFICIENTS);
         for (uint j = 0u; j < count; j++) {
             sums[j] += l * texelFetch(ray_harmonics, at + int(j)).r;

@@ -1,6 +1,7 @@
 //! The bake's ray casting on the GPU (Sedláček 2019, 3.2.3), through the scene ray
 //! caster's batched queries: each probe's rays through the texel centres of its
-//! equal-area octahedral map, and each receiver's cosine-distributed hemisphere rays.
+//! equal-area octahedral maps (one for the receivers' visibility match, coarser ones for
+//! the relight), and each receiver's cosine-distributed hemisphere rays.
 
 use glam::{Quat, Vec3};
 
@@ -48,6 +49,59 @@ impl ProbeViews {
     /// The angular radius of a texel's cone of equal solid angle, 4π / side² = π δ².
     pub fn texel_radius(&self) -> f32 {
         2.0 / self.side as f32
+    }
+}
+
+/// The rays each probe's relight reads (3.2.3.1; fewer at the far levels of detail,
+/// 4.2.2): through the texel centres of [`RelightRays::MAPS`] equal-area octahedral maps
+/// of sides `side`, `side / 2`, ..., each probe's maps one after the other, probe after
+/// probe. A coarser level reads a coarser map whole rather than every other texel of a
+/// fine one: a texel's centre is its solid angle's centroid, where the texel in the
+/// corner of a 2 × 2 block is half a texel off its block's, an error of the first order
+/// in the radiance's slope (`relight_maps_integrate_analytic_radiance`).
+pub struct RelightRays {
+    pub side: usize,
+    /// Per probe and ray, the hit (`RAY_NONE`: the sky).
+    pub hits: Vec<RayHit>,
+}
+
+impl RelightRays {
+    /// The maps: the finest for level 0 of the level of detail, half and a quarter of its
+    /// side for the coarser levels (`frame::LOD_RELIGHT_MAP`).
+    pub const MAPS: usize = 3;
+
+    /// Casts every probe's relight rays through maps beginning with side `side`.
+    pub fn cast(queries: &mut RayQueries, probes: &[Vec3], side: usize) -> Result<Self> {
+        let rays = Self::rays(side);
+        let mut all = Vec::with_capacity(probes.len() * rays.len());
+        for p in probes {
+            all.extend(rays.iter().map(|&(d, _)| query(*p, d, 0.0)));
+        }
+        Ok(Self {
+            side,
+            hits: queries.run(&all)?,
+        })
+    }
+
+    /// Each probe's rays, map after map: the direction and the solid angle it stands for.
+    pub fn rays(side: usize) -> Vec<(Vec3, f64)> {
+        (0..Self::MAPS)
+            .flat_map(|m| {
+                let s = side >> m;
+                let solid_angle = 4.0 * std::f64::consts::PI / (s * s) as f64;
+                (0..s * s).map(move |t| (octahedral::texel_direction(t, s), solid_angle))
+            })
+            .collect()
+    }
+
+    /// Where map `m` begins among a probe's rays, and its side.
+    pub fn map(side: usize, m: usize) -> (usize, usize) {
+        ((0..m).map(|k| (side >> k) * (side >> k)).sum(), side >> m)
+    }
+
+    /// The rays of each probe.
+    pub fn per_probe(side: usize) -> usize {
+        Self::map(side, Self::MAPS).0
     }
 }
 

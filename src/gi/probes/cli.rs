@@ -27,10 +27,15 @@ pub struct ProbeArgs {
     /// (Sedláček's N_OVERLAPS), 1 to 64 [default: 10].
     #[arg(long)]
     pub overlaps: Option<u32>,
-    /// Each probe casts a ray through every texel of an N × N equal-area octahedral map,
-    /// 8 to 256 [default: 64].
+    /// Each probe casts a ray through every texel of an N × N equal-area octahedral map
+    /// for the receivers' visibility match, 8 to 256 [default: 64].
     #[arg(long)]
     pub probe_side: Option<u32>,
+    /// Each probe's relight reads the rays through the texels of an N × N equal-area
+    /// octahedral map at level 0 of the level of detail, of N/2 × N/2 and N/4 × N/4 ones
+    /// at the others; N a multiple of 4, 16 to 256 [default: 64].
+    #[arg(long)]
+    pub relight_side: Option<u32>,
     /// Hemisphere rays per receiver for its transport coefficients, 1 to 4096
     /// [default: 64].
     #[arg(long)]
@@ -120,6 +125,7 @@ impl ProbeArgs {
             (self.probes.is_some(), "--probes"),
             (self.overlaps.is_some(), "--overlaps"),
             (self.probe_side.is_some(), "--probe-side"),
+            (self.relight_side.is_some(), "--relight-side"),
             (self.receiver_rays.is_some(), "--receiver-rays"),
             (self.sh_order.is_some(), "--sh-order"),
             (self.pca_error.is_some(), "--pca-error"),
@@ -147,6 +153,10 @@ impl ProbeArgs {
             probes: self.probes.or(scene.probes).unwrap_or(d.probes),
             overlaps: self.overlaps.or(scene.overlaps).unwrap_or(d.overlaps),
             probe_side: self.probe_side.or(scene.probe_side).unwrap_or(d.probe_side),
+            relight_side: self
+                .relight_side
+                .or(scene.relight_side)
+                .unwrap_or(d.relight_side),
             receiver_rays: self
                 .receiver_rays
                 .or(scene.receiver_rays)
@@ -196,6 +206,12 @@ impl ProbeArgs {
             bail!(
                 "--probe-side {}: each probe's map is 8 to 256 texels wide",
                 settings.probe_side
+            );
+        }
+        if !(16..=256).contains(&settings.relight_side) || settings.relight_side % 4 != 0 {
+            bail!(
+                "--relight-side {}: each probe's relight map is 16 to 256 texels wide, a multiple of 4",
+                settings.relight_side
             );
         }
         if !(1..=4096).contains(&settings.receiver_rays) {

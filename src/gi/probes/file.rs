@@ -19,7 +19,7 @@ use crate::scene::Scene;
 
 const MAGIC: &[u8; 8] = b"VXCBAKE\0";
 /// Raised whenever the payload's sections or their meaning change.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 const HEADER: usize = 8 + 4 + 4 + 16 + 8 + 16;
 
 /// What a frame of `--gi probes` reads from a bake.
@@ -44,8 +44,10 @@ pub struct BakeData {
     pub grid_size: [u32; 3],
     pub grid_bounds: [[f32; 3]; 2],
     pub probes: Vec<[f32; 3]>,
-    pub probe_side: u32,
-    pub probe_hits: Vec<RayHit>,
+    /// The relight maps' first side and every probe's relight rays' hits
+    /// ([`super::casting::RelightRays`]).
+    pub relight_side: u32,
+    pub relight_hits: Vec<RayHit>,
     /// Per cluster: where its probes start in `cluster_probes`, its basis count, where
     /// its (Σ V^T)_k starts in `projections` (each with an end, last).
     pub cluster_probe_starts: Vec<u32>,
@@ -78,6 +80,7 @@ pub fn content_key(scene: &Scene, settings: &BakeSettings) -> u128 {
         settings.probes,
         settings.overlaps,
         settings.probe_side,
+        settings.relight_side,
         settings.receiver_rays,
         settings.sh_order,
         settings.pca_error.to_bits(),
@@ -136,7 +139,7 @@ impl BakeData {
     pub fn write(&self, path: &Path, key: u128) -> Result<()> {
         let mut payload = Vec::new();
         section(&mut payload, &self.lightmap);
-        section(&mut payload, &[self.sh_order, self.probe_side]);
+        section(&mut payload, &[self.sh_order, self.relight_side]);
         section(&mut payload, &self.mesh_corners);
         section(&mut payload, &self.corner_uvs);
         section(&mut payload, &self.receiver_texels);
@@ -147,7 +150,7 @@ impl BakeData {
         section(&mut payload, &self.grid_size);
         section(&mut payload, &self.grid_bounds);
         section(&mut payload, &self.probes);
-        section(&mut payload, &self.probe_hits);
+        section(&mut payload, &self.relight_hits);
         section(&mut payload, &self.cluster_probe_starts);
         section(&mut payload, &self.cluster_probes);
         section(&mut payload, &self.cluster_basis);
@@ -247,7 +250,7 @@ impl BakeData {
         let data = Self {
             lightmap: [lightmap[0], lightmap[1]],
             sh_order: orders[0],
-            probe_side: orders[1],
+            relight_side: orders[1],
             mesh_corners: array(next()?)?,
             corner_uvs: array(next()?)?,
             receiver_texels: array(next()?)?,
@@ -258,7 +261,7 @@ impl BakeData {
             grid_size: exactly(array(next()?)?, "the grid's size")?,
             grid_bounds: exactly(array(next()?)?, "the grid's box")?,
             probes: array(next()?)?,
-            probe_hits: array(next()?)?,
+            relight_hits: array(next()?)?,
             cluster_probe_starts: array(next()?)?,
             cluster_probes: array(next()?)?,
             cluster_basis: array(next()?)?,
@@ -275,6 +278,17 @@ impl BakeData {
         ];
         if counts.iter().any(|&n| n != receivers) {
             bail!("the receivers' tables do not match their count ({receivers})");
+        }
+        let side = data.relight_side as usize;
+        if !(16..=256).contains(&side) || side % 4 != 0 {
+            bail!("the relight maps' side ({side}) is not a multiple of 4 from 16 to 256");
+        }
+        let rays = super::casting::RelightRays::per_probe(side);
+        if data.relight_hits.len() != data.probes.len() * rays {
+            bail!(
+                "the relight rays' hits do not match {} probes of {rays} rays",
+                data.probes.len()
+            );
         }
         let clusters = data.cluster_basis.len();
         if data.cluster_bounds.len() != clusters

@@ -28,11 +28,12 @@ use anyhow::{bail, Result};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
+use super::casting::RelightRays;
 use super::file::BakeData;
 use super::grid::Grid;
 use super::levels::{LightmapLevels, Work, LEVELS};
 use super::sh::Basis;
-use super::{octahedral, BakeReport, BakeSettings, Origin};
+use super::{BakeReport, BakeSettings, Origin};
 use crate::gi::bounces::MAX_BOUNCES;
 use crate::gi::{
     DebugView, FrameInputs, GatherOptions, Gathered, Inputs, Preparation, Screen, ScreenRequest,
@@ -135,12 +136,13 @@ pub(super) const LIGHTMAP_USE: ImageUse = ImageUse {
 const MAX_GROUPS: u32 = 65535;
 
 /// The level of detail's levels (Sedláček 2019, 4.2): per level, the highest harmonic
-/// band the probes project onto (never above the bake's) and the stride of the relight's
-/// rays along each axis of the probes' maps. The thesis's example: 64, 25 and 16
-/// coefficients, and rays halved level by level; here a level quarters the rays, as
-/// the map's blocks do, until 256 of 4,096 are left.
+/// band the probes project onto (never above the bake's) and the relight map its probes
+/// read ([`RelightRays`]). The thesis's example: 64, 25 and 16 coefficients, and rays
+/// halved level by level (512, 256, 128, 64); here a level quarters the rays, until a
+/// sixteenth of level 0's are left (4,096, 1,024, 256 and 256 at the default
+/// `--relight-side`).
 const LOD_BANDS: [u32; 4] = [7, 5, 3, 2];
-const LOD_RAY_STRIDE: [u32; 4] = [1, 2, 4, 4];
+const LOD_RELIGHT_MAP: [usize; 4] = [0, 1, 2, 2];
 
 /// Where levels 1, 2 and 3 begin by default, in probe radii from the camera. Band 7
 /// resolves about a seventh of a probe's sphere, detail a half radius across on its
@@ -297,7 +299,7 @@ impl LevelsOfDetail {
             .iter()
             .map(|&l| {
                 per_level[l] += 1;
-                self.coefficients(l) | LOD_RAY_STRIDE[l] << 16
+                self.coefficients(l) | (l as u32) << 16
             })
             .collect();
         entries.extend(clusters);
@@ -361,7 +363,7 @@ impl Tables {
             first += count;
         }
         let hits = data
-            .probe_hits
+            .relight_hits
             .iter()
             .map(|h: &RayHit| {
                 let triangle = if h.triangle == RAY_NONE {
@@ -372,16 +374,17 @@ impl Tables {
                 [triangle, h.t.to_bits(), h.u.to_bits(), h.v.to_bits()]
             })
             .collect();
-        let side = data.probe_side as usize;
-        let rays = side * side;
+        let side = data.relight_side as usize;
+        let relight_rays = RelightRays::rays(side);
+        let rays = relight_rays.len();
         let basis = Basis::new(data.sh_order);
-        let solid_angle = 4.0 * std::f64::consts::PI / rays as f64;
         let mut y = vec![0.0f64; n];
         let mut harmonics = Vec::with_capacity(rays * n);
-        for t in 0..rays {
-            basis.eval_into(octahedral::texel_direction(t, side), &mut y);
+        for &(d, solid_angle) in &relight_rays {
+            basis.eval_into(d, &mut y);
             harmonics.extend(y.iter().map(|y| (y * solid_angle) as f32));
         }
+        let maps = LOD_RELIGHT_MAP.map(|m| RelightRays::map(side, m));
         let clusters = data.cluster_basis.len();
         let mut first_vector = Vec::with_capacity(clusters);
         let mut vectors = Vec::new();
@@ -468,6 +471,8 @@ impl Tables {
             sky_offset: data.coordinates.len() as u32,
             bounces: u32::from(bounces),
             debug_radius,
+            relight_first: maps.map(|(first, _)| first as u32),
+            relight_side: maps.map(|(_, side)| side as u32),
             grid_size: [gx, gy, gz, data.grid_points() as u32],
             grid_min,
             grid_inverse_extent,
@@ -1448,6 +1453,7 @@ impl Technique for ProbeGi {
             ("clusters".into(), r.clusters as f64),
             ("basis_vectors".into(), f64::from(self.counts.vector_count)),
             ("probe_rays".into(), r.probe_rays as f64),
+            ("relight_rays".into(), r.relight_rays as f64),
             (
                 "sh_coefficients".into(),
                 f64::from(self.counts.coefficients),

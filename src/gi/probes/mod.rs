@@ -34,7 +34,7 @@ use std::time::Instant;
 use anyhow::Result;
 use serde::{Deserialize, Serialize};
 
-use self::casting::ProbeViews;
+use self::casting::{ProbeViews, RelightRays};
 use self::clusters::{ClusterSettings, Clusters};
 use self::file::{BakeData, Unusable};
 use self::lightmap::Lightmap;
@@ -55,8 +55,12 @@ pub struct BakeSettings {
     pub probes: u32,
     /// N_OVERLAPS: the most probes per receiver.
     pub overlaps: u32,
-    /// Each probe's rays: through the texels of a `probe_side`² equal-area octahedral map.
+    /// Each probe's rays for the receivers' visibility match: through the texels of a
+    /// `probe_side`² equal-area octahedral map.
     pub probe_side: u32,
+    /// Each probe's relight rays: through the texels of a `relight_side`² map for level 0
+    /// of the level of detail, of maps of half and a quarter of the side for the others.
+    pub relight_side: u32,
     /// Each receiver's hemisphere rays.
     pub receiver_rays: u32,
     /// The highest band of the harmonics: (order + 1)² coefficients.
@@ -77,6 +81,14 @@ impl Default for BakeSettings {
             probes: 256,
             overlaps: 10,
             probe_side: 64,
+            // The probes' maps' side: the relight's 64 coefficients from 4,096 rays (the
+            // thesis: 512). 32² costs a quarter and projects a clamped cosine's and a
+            // half-space step's irradiance nearly as well (0.1 % and 0.4 % off on average
+            // against 64²'s 0.03 % and 0.2 %, `relight_maps_integrate_analytic_radiance`),
+            // but not an emitter a probe sees under a few degrees: `cornell_area`'s
+            // ceiling light, whose light all comes through the probes, LDR-FLIP 0.086 →
+            // 0.106 (BENCHMARKS.md, session 52).
+            relight_side: 64,
             receiver_rays: 64,
             // The thesis's bands 0 to 7. The probes' radiance has the lights' hot spots and
             // shadow edges in it: on the Cornell box the first bounce came out 7.5 %, 3.8 %
@@ -125,7 +137,9 @@ pub struct BakeReport {
     /// light: 3.2.3.2).
     pub mean_support: f64,
     pub unsupported_receivers: usize,
+    /// Rays cast: the probes' visibility maps, their relight maps, the receivers'.
     pub probe_rays: usize,
+    pub relight_rays: usize,
     pub receiver_rays: usize,
     /// The share of the receivers' rays that hit a surface no supporting probe sees
     /// (their light is lost).
@@ -289,6 +303,11 @@ pub fn compute(
         &probes.positions,
         settings.probe_side as usize,
     )?;
+    let relight_rays = RelightRays::cast(
+        &mut queries,
+        &probes.positions,
+        settings.relight_side as usize,
+    )?;
     lap("probe rays");
     let transport_settings = TransportSettings {
         order: settings.sh_order,
@@ -315,7 +334,13 @@ pub fn compute(
     // The compression's error where it matters, in the receivers' irradiance from the
     // emitters and the sky: through the clusters against the full transport.
     let basis = sh::Basis::new(settings.sh_order);
-    let lambda = relight::emitted_lambda(scene, &triangles, &views, probes.positions.len(), &basis);
+    let lambda = relight::emitted_lambda(
+        scene,
+        &triangles,
+        &relight_rays,
+        probes.positions.len(),
+        &basis,
+    );
     let (mut difference, mut total) = (0.0f64, 0.0f64);
     let mut compressed = Vec::with_capacity(receivers.list.len());
     for i in 0..receivers.list.len() {
@@ -400,6 +425,7 @@ pub fn compute(
         mean_support: support.iter().sum::<usize>() as f64 / support.len().max(1) as f64,
         unsupported_receivers: support.len() - supported,
         probe_rays: views.hits.len(),
+        relight_rays: relight_rays.hits.len(),
         receiver_rays: receivers.list.len() * settings.receiver_rays as usize,
         unseen_hit_share: transport.unseen as f64 / transport.hits.max(1) as f64,
         unseen_from_the_side_share: transport.unseen_side as f64 / transport.unseen.max(1) as f64,
@@ -445,8 +471,8 @@ pub fn compute(
         grid_size: grid.map_or([0; 3], |g| g.size.to_array()),
         grid_bounds: grid.map_or([[0.0; 3]; 2], |g| [g.min.to_array(), g.max.to_array()]),
         probes: probes.positions.iter().map(|p| p.to_array()).collect(),
-        probe_side: settings.probe_side,
-        probe_hits: views.hits,
+        relight_side: settings.relight_side,
+        relight_hits: relight_rays.hits,
         cluster_probe_starts,
         cluster_probes: clusters
             .list

@@ -1,7 +1,8 @@
 //! The probes' relight and the receivers' reconstruction on the host (Sedláček 2019,
 //! 3.3.1.1 and 3.3.1.3, before the clusters): the radiance each probe ray meets,
-//! projected onto the harmonics, λ_ij = 4π / N Σ_rays L Y_j (the map's texels are equal
-//! in solid angle), and each receiver's irradiance Σ_ij λ_ij α_ij plus its sky.
+//! projected onto the harmonics, λ_ij = 4π / N Σ_rays L Y_j over the N rays of the finest
+//! relight map (its texels are equal in solid angle), and each receiver's irradiance
+//! Σ_ij λ_ij α_ij plus its sky.
 //!
 //! Of the radiance at the hits this holds what the bake knows without the frame: the
 //! materials' emission (one-sided, along the winding's normal; emission textures are
@@ -10,33 +11,32 @@
 
 use glam::Vec3;
 
-use super::casting::{triangle_normal, ProbeViews};
-use super::octahedral;
+use super::casting::{triangle_normal, RelightRays};
 use super::sh::Basis;
 use super::transport::Transport;
 use crate::gpu_layout::RAY_NONE;
 use crate::ray::Triangles;
 use crate::scene::Scene;
 
-/// λ of every probe from the emission and sky its rays meet: `probes` × (order + 1)²
-/// RGB coefficients.
+/// λ of every probe from the emission and sky its rays of the finest relight map meet
+/// (level 0 of the level of detail): `probes` × (order + 1)² RGB coefficients.
 pub fn emitted_lambda(
     scene: &Scene,
     triangles: &Triangles,
-    views: &ProbeViews,
+    relight: &RelightRays,
     probes: usize,
     basis: &Basis,
 ) -> Vec<Vec3> {
-    let texels = views.side * views.side;
+    let per_probe = RelightRays::per_probe(relight.side);
+    let (first, side) = RelightRays::map(relight.side, 0);
+    let rays = &RelightRays::rays(relight.side)[first..first + side * side];
     let n = basis.count();
-    let weight = 4.0 * std::f64::consts::PI / texels as f64;
     let mut lambda = vec![Vec3::ZERO; probes * n];
     let mut y = vec![0.0f64; n];
     for p in 0..probes {
         let mut sums = vec![[0.0f64; 3]; n];
-        for t in 0..texels {
-            let hit = &views.hits[p * texels + t];
-            let dir = octahedral::texel_direction(t, views.side);
+        for (t, &(dir, weight)) in rays.iter().enumerate() {
+            let hit = &relight.hits[p * per_probe + first + t];
             let radiance = if hit.triangle == RAY_NONE {
                 scene.sky
             } else {

@@ -275,8 +275,34 @@ mod tests {
         }
     }
 
-    /// A narrow lobe, the cap of half-angle 20° about a: g_l = 2π K_l^0 ∫ from cos 20° to 1
-    /// of P_l = 2π K_l^0 (P_{l-1}(c) - P_{l+1}(c)) / (2l + 1); its band-limited
+    /// P_l(x) by Bonnet's recurrence.
+    fn legendre(l: i32, x: f64) -> f64 {
+        let (mut a, mut b) = (1.0, x);
+        for n in 2..=l {
+            let next = ((2 * n - 1) as f64 * x * b - (n - 1) as f64 * a) / n as f64;
+            a = b;
+            b = next;
+        }
+        if l == 0 {
+            a
+        } else {
+            b
+        }
+    }
+
+    /// The zonal coefficient g_l about z of the cap cos θ ≥ c (1 inside, 0 outside):
+    /// 2π K_l^0 ∫ from c to 1 of P_l = 2π K_l^0 (P_{l-1}(c) - P_{l+1}(c)) / (2l + 1).
+    fn cap_band(l: i32, c: f64) -> f64 {
+        let k = ((2 * l + 1) as f64 / (4.0 * PI)).sqrt();
+        let integral = if l == 0 {
+            1.0 - c
+        } else {
+            (legendre(l - 1, c) - legendre(l + 1, c)) / (2 * l + 1) as f64
+        };
+        2.0 * PI * k * integral
+    }
+
+    /// A narrow lobe, the cap of half-angle 20° about a, [`cap_band`]; its band-limited
     /// reconstruction along a is Σ_l √((2l + 1) / 4π) g_l.
     #[test]
     fn a_narrow_cap_projects_and_reconstructs_to_its_closed_form() {
@@ -290,30 +316,11 @@ mod tests {
                 0.0
             }
         });
-        // P_l by Bonnet's recurrence.
-        let legendre = |l: i32, x: f64| -> f64 {
-            let (mut a, mut b) = (1.0, x);
-            for n in 2..=l {
-                let next = ((2 * n - 1) as f64 * x * b - (n - 1) as f64 * a) / n as f64;
-                a = b;
-                b = next;
-            }
-            if l == 0 {
-                a
-            } else {
-                b
-            }
-        };
         let y = basis.eval(axis);
         let mut reconstruction = 0.0;
         for l in 0..=MAX_ORDER as i32 {
             let k = ((2 * l + 1) as f64 / (4.0 * PI)).sqrt();
-            let integral = if l == 0 {
-                1.0 - cos_cap
-            } else {
-                (legendre(l - 1, cos_cap) - legendre(l + 1, cos_cap)) / (2 * l + 1) as f64
-            };
-            let g = 2.0 * PI * k * integral;
+            let g = cap_band(l, cos_cap);
             reconstruction += k * g;
             for m in -l..=l {
                 let j = (l * l + l + m) as usize;
@@ -348,5 +355,78 @@ mod tests {
         assert!((sums[0] - (4.0 * PI).sqrt()).abs() < 1e-6);
         let worst = sums[1..].iter().map(|s| s.abs()).fold(0.0, f64::max);
         assert!(worst < 5e-3, "a higher band integrates to {worst}");
+    }
+
+    /// The relight's quadrature (`casting::RelightRays`): each map's rays project a
+    /// clamped cosine and a half-space step (a shadow's edge) about a dozen axes onto
+    /// bands 0 to 7, and the irradiance those coefficients give every normal, Σ Â_l
+    /// c_lm Y_lm, is compared with the closed form's (the zonal coefficients turned to the
+    /// axis). Mean error over axes and normals, as a share of the mean irradiance:
+    /// 64² 0.02 % and 0.15 %, 32² 0.10 % and 0.41 %, 16² 0.40 % and 1.3 %; the corner
+    /// texels of 64²'s 2 × 2 blocks, which the far levels' relight read before, 1.4 % and
+    /// 1.5 % (over 24 axes).
+    #[test]
+    fn relight_maps_integrate_analytic_radiance() {
+        use crate::gi::probes::casting::RelightRays;
+        let basis = Basis::new(MAX_ORDER);
+        let axes = sphere_directions(12);
+        let normals = sphere_directions(400);
+        let side = 64;
+        let rays = RelightRays::rays(side);
+        let maps = [
+            (0, [0.0005, 0.0025]),
+            (1, [0.0015, 0.0065]),
+            (2, [0.006, 0.021]),
+        ];
+        for (m, bounds) in maps {
+            let (first, s) = RelightRays::map(side, m);
+            let map = &rays[first..first + s * s];
+            let solid: f64 = map.iter().map(|r| r.1).sum();
+            assert!((solid - 4.0 * PI).abs() < 1e-9, "map {m}: {solid} sr");
+            for (f, cap, bound) in [("cosine", None, bounds[0]), ("step", Some(0.0), bounds[1])] {
+                let (mut error, mut total) = (0.0, 0.0);
+                for &axis in &axes {
+                    let radiance = |d: Vec3| {
+                        let c = f64::from(d.dot(axis));
+                        match cap {
+                            None => c.max(0.0),
+                            Some(c0) => f64::from(u8::from(c >= c0)),
+                        }
+                    };
+                    let mut sampled = vec![0.0; basis.count()];
+                    let mut y = vec![0.0; basis.count()];
+                    for &(d, w) in map {
+                        basis.eval_into(d, &mut y);
+                        let v = radiance(d) * w;
+                        for (c, y) in sampled.iter_mut().zip(&y) {
+                            *c += v * y;
+                        }
+                    }
+                    let ya = basis.eval(axis);
+                    for &n in &normals {
+                        basis.eval_into(n, &mut y);
+                        let (mut got, mut want) = (0.0, 0.0);
+                        for l in 0..=MAX_ORDER as i32 {
+                            let zonal = match cap {
+                                None => clamped_cosine_band(l as u32),
+                                Some(c0) => {
+                                    (4.0 * PI / (2 * l + 1) as f64).sqrt() * cap_band(l, c0)
+                                }
+                            };
+                            let a = clamped_cosine_band(l as u32);
+                            for j in (l * l) as usize..((l + 1) * (l + 1)) as usize {
+                                got += a * sampled[j] * y[j];
+                                want += a * zonal * ya[j] * y[j];
+                            }
+                        }
+                        error += (got - want).abs();
+                        total += want.abs();
+                    }
+                }
+                let share = error / total;
+                eprintln!("map {m} ({s}²), {f}: mean irradiance error {share:.5}");
+                assert!(share <= bound, "map {m} ({s}²), {f}: {share} > {bound}");
+            }
+        }
     }
 }
