@@ -3,8 +3,8 @@
 // probe: the radiance each of its rays meets, projected onto the real harmonics,
 // λ_j = Σ_rays L Y_j dω over the rays of one of its relight maps (`RelightRays`: an
 // equal-area octahedral map's texels, so dω is 4π over its texels; BINDING_PROBE_SH holds
-// Y_j dω). The radiance at a hit is what a Lambertian surface
-// sends back towards the probe, in the lighting pass's units and model:
+// Y_j dω). The radiance at a hit is what a Lambertian surface sends back towards the
+// probe, in the lighting pass's units and model:
 // - the direct light of every light, shadowed by the frame's shadow maps, × albedo / π;
 // - the emission, from the front of an emitter only (one-sided, as the G-buffer);
 // - last frame's lightmap (irradiance / π) × albedo: each frame adds a bounce, as the

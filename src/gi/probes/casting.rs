@@ -56,7 +56,7 @@ impl ProbeViews {
 /// 4.2.2): through the texel centres of [`RelightRays::MAPS`] equal-area octahedral maps
 /// of sides `side`, `side / 2`, ..., each probe's maps one after the other, probe after
 /// probe. A coarser level reads a coarser map whole rather than every other texel of a
-/// fine one: a texel's centre is its solid angle's centroid, where the texel in the
+/// fine one: a texel's centre is close to its solid angle's centre, where the texel in the
 /// corner of a 2 × 2 block is half a texel off its block's, an error of the first order
 /// in the radiance's slope (`relight_maps_integrate_analytic_radiance`).
 pub struct RelightRays {

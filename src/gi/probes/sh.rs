@@ -362,9 +362,9 @@ mod tests {
     /// bands 0 to 7, and the irradiance those coefficients give every normal, Σ Â_l
     /// c_lm Y_lm, is compared with the closed form's (the zonal coefficients turned to the
     /// axis). Mean error over axes and normals, as a share of the mean irradiance:
-    /// 64² 0.02 % and 0.15 %, 32² 0.10 % and 0.41 %, 16² 0.40 % and 1.3 %; the corner
-    /// texels of 64²'s 2 × 2 blocks, which the far levels' relight read before, 1.4 % and
-    /// 1.5 % (over 24 axes).
+    /// 64² 0.02 % and 0.15 %, 32² 0.10 % and 0.41 %, 16² 0.40 % and 1.3 %; one texel of
+    /// each of 64²'s 2 × 2 blocks, as level 1's relight read before, 1.4 % and 1.5 % (over
+    /// 24 axes).
     #[test]
     fn relight_maps_integrate_analytic_radiance() {
         use crate::gi::probes::casting::RelightRays;
