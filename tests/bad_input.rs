@@ -289,6 +289,18 @@ fn bad_probe_settings() {
             "render",
             "--gi",
             "probes",
+            "--relight-side",
+            "30",
+            "-o",
+            "x.png",
+        ],
+        &["--relight-side 30", "16 to 256", "a multiple of 4"],
+    );
+    assert_fails_naming(
+        &[
+            "render",
+            "--gi",
+            "probes",
             "--spatial-receivers",
             "300000",
             "-o",
