@@ -307,6 +307,29 @@ impl LevelsOfDetail {
     }
 }
 
+/// Whether the decoded surfaces of `rays` relight rays (two texels of 16 bytes each) fit
+/// one texel buffer of `texel_limit` elements, which the relight reads, and one storage
+/// binding of `storage_limit` bytes, which `probe_surfaces` writes.
+pub(super) fn check_relight_rays(rays: u64, texel_limit: u64, storage_limit: u64) -> Result<()> {
+    if 2 * rays > texel_limit {
+        bail!(
+            "the bake's {rays} relight rays need {} texels, more than the {texel_limit} this \
+             device binds in one texel buffer: bake fewer --probes or a smaller --relight-side",
+            2 * rays
+        );
+    }
+    if 32 * rays > storage_limit {
+        bail!(
+            "the bake's {rays} relight rays' surfaces take {} MiB, more than the {} MiB this \
+             device binds in one storage buffer: bake fewer --probes or a smaller \
+             --relight-side",
+            (32 * rays).div_ceil(1 << 20),
+            storage_limit >> 20
+        );
+    }
+    Ok(())
+}
+
 /// The bake's tables as the passes read them, built on the host.
 struct Tables {
     hits: Vec<[u32; 4]>,
@@ -761,14 +784,13 @@ impl ProbeGi {
             bytemuck::cast_slice(&tables.hits),
         )?;
         let rays = u64::from(counts.probe_count) * u64::from(counts.rays_per_probe);
-        let texel_limit = u64::from(ctx.properties.limits.max_texel_buffer_elements);
-        if 2 * rays > texel_limit {
-            bail!(
-                "the bake's {rays} probe rays need {} texels, more than the {texel_limit} this \
-                 device binds in one texel buffer: bake fewer --probes or a smaller --probe-side",
-                2 * rays
-            );
-        }
+        let limits = &ctx.properties.limits;
+        let texel_limit = u64::from(limits.max_texel_buffer_elements);
+        check_relight_rays(
+            rays,
+            texel_limit,
+            u64::from(limits.max_storage_buffer_range),
+        )?;
         let hit_surfaces = TexelBuffer::new(
             "probe surfaces",
             Buffer::new(
