@@ -441,7 +441,7 @@ gpu_layout! {
         /// Irradiance probes (set 3): what each probe ray met, decoded once (`surfaces.comp`), two
         /// `uvec4`s per ray: position and albedo (RGBA8; alpha 0 for a miss); the normal towards
         /// the probe (octahedral snorm16), the lightmap uv (unorm16, all ones for none) and the
-        /// emitted radiance (half floats), `uvec4[]` storage buffer.
+        /// emitted radiance (half floats), `uimageBuffer` (rgba32ui) storage texel buffer.
         BINDING_PROBE_SURFACES = 23;
         /// Irradiance probes (set 3): the same buffer read by the relight, a `usamplerBuffer`.
         BINDING_PROBE_SURFACES_READ = 24;

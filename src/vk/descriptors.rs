@@ -105,7 +105,7 @@ pub struct SetWriter<'a> {
     set: vk::DescriptorSet,
     buffers: Vec<(u32, vk::DescriptorType, vk::DescriptorBufferInfo)>,
     images: Vec<(u32, vk::DescriptorType, Vec<vk::DescriptorImageInfo>)>,
-    texel_views: Vec<(u32, vk::BufferView)>,
+    texel_views: Vec<(u32, vk::DescriptorType, vk::BufferView)>,
     ctx: &'a Context,
 }
 
@@ -132,7 +132,14 @@ impl<'a> SetWriter<'a> {
 
     /// A uniform texel buffer (`samplerBuffer`).
     pub fn texel_buffer(mut self, binding: u32, view: vk::BufferView) -> Self {
-        self.texel_views.push((binding, view));
+        let kind = vk::DescriptorType::UNIFORM_TEXEL_BUFFER;
+        self.texel_views.push((binding, kind, view));
+        self
+    }
+
+    pub fn storage_texel_buffer(mut self, binding: u32, view: vk::BufferView) -> Self {
+        let kind = vk::DescriptorType::STORAGE_TEXEL_BUFFER;
+        self.texel_views.push((binding, kind, view));
         self
     }
 
@@ -208,12 +215,12 @@ impl<'a> SetWriter<'a> {
                     .image_info(infos),
             );
         }
-        for (binding, view) in &self.texel_views {
+        for (binding, kind, view) in &self.texel_views {
             writes.push(
                 vk::WriteDescriptorSet::default()
                     .dst_set(self.set)
                     .dst_binding(*binding)
-                    .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
+                    .descriptor_type(*kind)
                     .texel_buffer_view(std::slice::from_ref(view)),
             );
         }

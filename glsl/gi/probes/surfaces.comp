@@ -11,9 +11,7 @@ layout(local_size_x = PROBE_GROUP_SIZE) in;
 
 layout(set = SET_GI, binding = BINDING_PROBE_HITS) uniform usamplerBuffer probe_hits;
 layout(set = SET_GI, binding = BINDING_PROBE_POSITIONS) uniform samplerBuffer probe_positions;
-layout(set = SET_GI, binding = BINDING_PROBE_SURFACES, std430) writeonly buffer SurfaceBlock {
-    uvec4 surfaces[];
-};
+layout(set = SET_GI, binding = BINDING_PROBE_SURFACES, rgba32ui) uniform writeonly uimageBuffer surfaces;
 
 void main() {
     // Rows of at most 65,535 workgroups.
@@ -23,8 +21,8 @@ void main() {
     }
     uvec4 hit = texelFetch(probe_hits, int(ray));
     if (hit.x == RAY_NONE) {
-        surfaces[2u * ray] = uvec4(0u);
-        surfaces[2u * ray + 1u] = uvec4(0u);
+        imageStore(surfaces, int(2u * ray), uvec4(0u));
+        imageStore(surfaces, int(2u * ray + 1u), uvec4(0u));
         return;
     }
     vec3 origin = texelFetch(probe_positions, int(ray / probes.rays_per_probe)).xyz;
@@ -53,7 +51,8 @@ void main() {
         }
     }
     vec2 at = lightmap_uv(hit.x, bary);
-    surfaces[2u * ray] = uvec4(floatBitsToUint(p), packUnorm4x8(vec4(albedo, 1.0)));
-    surfaces[2u * ray + 1u] = uvec4(pack_normal(n), at.x >= 0.0 ? packUnorm2x16(at) : NO_LIGHTMAP_UV,
-                                    packHalf2x16(emitted.rg), packHalf2x16(vec2(emitted.b, 0.0)));
+    imageStore(surfaces, int(2u * ray), uvec4(floatBitsToUint(p), packUnorm4x8(vec4(albedo, 1.0))));
+    imageStore(surfaces, int(2u * ray + 1u),
+               uvec4(pack_normal(n), at.x >= 0.0 ? packUnorm2x16(at) : NO_LIGHTMAP_UV,
+                     packHalf2x16(emitted.rg), packHalf2x16(vec2(emitted.b, 0.0))));
 }

@@ -307,24 +307,15 @@ impl LevelsOfDetail {
     }
 }
 
-/// Whether the decoded surfaces of `rays` relight rays (two texels of 16 bytes each) fit
-/// one texel buffer of `texel_limit` elements, which the relight reads, and one storage
-/// binding of `storage_limit` bytes, which `probe_surfaces` writes.
-pub(super) fn check_relight_rays(rays: u64, texel_limit: u64, storage_limit: u64) -> Result<()> {
+/// Whether the decoded surfaces of `rays` relight rays (two texels each) fit one texel
+/// buffer of `texel_limit` elements, through which `probe_surfaces` writes them and the
+/// relight reads them. (A storage buffer would bind far less: 128 MiB on lavapipe.)
+pub(super) fn check_relight_rays(rays: u64, texel_limit: u64) -> Result<()> {
     if 2 * rays > texel_limit {
         bail!(
             "the bake's {rays} relight rays need {} texels, more than the {texel_limit} this \
              device binds in one texel buffer: bake fewer --probes or a smaller --relight-side",
             2 * rays
-        );
-    }
-    if 32 * rays > storage_limit {
-        bail!(
-            "the bake's {rays} relight rays' surfaces take {} MiB, more than the {} MiB this \
-             device binds in one storage buffer: bake fewer --probes or a smaller \
-             --relight-side",
-            (32 * rays).div_ceil(1 << 20),
-            storage_limit >> 20
         );
     }
     Ok(())
@@ -784,20 +775,16 @@ impl ProbeGi {
             bytemuck::cast_slice(&tables.hits),
         )?;
         let rays = u64::from(counts.probe_count) * u64::from(counts.rays_per_probe);
-        let limits = &ctx.properties.limits;
-        let texel_limit = u64::from(limits.max_texel_buffer_elements);
-        check_relight_rays(
-            rays,
-            texel_limit,
-            u64::from(limits.max_storage_buffer_range),
-        )?;
+        let texel_limit = u64::from(ctx.properties.limits.max_texel_buffer_elements);
+        check_relight_rays(rays, texel_limit)?;
         let hit_surfaces = TexelBuffer::new(
             "probe surfaces",
             Buffer::new(
                 ctx,
                 "probe surfaces",
                 (32 * rays).max(32),
-                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
+                vk::BufferUsageFlags::STORAGE_TEXEL_BUFFER
+                    | vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER,
                 MemoryLocation::GpuOnly,
             )?,
             vk::Format::R32G32B32A32_UINT,
@@ -1031,7 +1018,7 @@ impl ProbeGi {
             Binding::new(layout::BINDING_PROBE_POSITIONS, texels, compute),
             Binding::new(
                 layout::BINDING_PROBE_SURFACES,
-                vk::DescriptorType::STORAGE_BUFFER,
+                vk::DescriptorType::STORAGE_TEXEL_BUFFER,
                 compute,
             ),
             Binding::new(layout::BINDING_PROBE_SURFACES_READ, texels, compute),
@@ -1111,11 +1098,7 @@ impl ProbeGi {
                     vk::ImageLayout::GENERAL,
                 )
                 .texel_buffer(layout::BINDING_PROBE_HITS, hits.view())
-                .buffer(
-                    layout::BINDING_PROBE_SURFACES,
-                    storage_buffer,
-                    hit_surfaces.buffer.raw,
-                )
+                .storage_texel_buffer(layout::BINDING_PROBE_SURFACES, hit_surfaces.view())
                 .texel_buffer(layout::BINDING_PROBE_SURFACES_READ, hit_surfaces.view())
                 .texel_buffer(layout::BINDING_PROBE_SH, t.harmonics.view())
                 .texel_buffer(layout::BINDING_PROBE_VECTORS, t.vectors.view())
