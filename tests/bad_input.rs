@@ -294,7 +294,7 @@ fn bad_probe_settings() {
             "-o",
             "x.png",
         ],
-        &["--relight-side 30", "16 to 256", "a multiple of 4"],
+        &["--relight-side 30", "16 to 128", "a multiple of 4"],
     );
     assert_fails_naming(
         &[
