@@ -99,6 +99,13 @@ impl RelightRays {
         ((0..m).map(|k| (side >> k) * (side >> k)).sum(), side >> m)
     }
 
+    /// Whether `side` is a side the relight's maps may start from: its quarter whole,
+    /// and no 256² (which relights too dark, a cause not yet found: BENCHMARKS.md,
+    /// session 52).
+    pub fn allows(side: usize) -> bool {
+        (16..=128).contains(&side) && side % 4 == 0
+    }
+
     /// The rays of each probe.
     pub fn per_probe(side: usize) -> usize {
         Self::map(side, Self::MAPS).0

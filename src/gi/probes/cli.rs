@@ -208,10 +208,7 @@ impl ProbeArgs {
                 settings.probe_side
             );
         }
-        // 256² relit every probe too dark (0.79 of the image's mean at 192² and below, on
-        // lavapipe, as `--probe-side 256` did before the relight had maps of its own): not
-        // yet explained (BENCHMARKS.md, session 52), so not offered.
-        if !(16..=128).contains(&settings.relight_side) || settings.relight_side % 4 != 0 {
+        if !super::casting::RelightRays::allows(settings.relight_side as usize) {
             bail!(
                 "--relight-side {}: each probe's relight map is 16 to 128 texels wide, a multiple of 4",
                 settings.relight_side

@@ -280,7 +280,7 @@ impl BakeData {
             bail!("the receivers' tables do not match their count ({receivers})");
         }
         let side = data.relight_side as usize;
-        if !(16..=128).contains(&side) || side % 4 != 0 {
+        if !super::casting::RelightRays::allows(side) {
             bail!("the relight maps' side ({side}) is not a multiple of 4 from 16 to 128");
         }
         let rays = super::casting::RelightRays::per_probe(side);
